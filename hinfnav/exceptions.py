@@ -1,0 +1,47 @@
+"""Exception classes of hinfnav.
+
+Every error the package raises on purpose derives from :class:`HinfnavError`,
+so a caller can catch all of them at once. Input errors also derive from
+:class:`ValueError`, so code written against NumPy conventions keeps working.
+"""
+
+__all__ = [
+    "HinfnavError",
+    "InputError",
+    "UnstablePlantError",
+    "SynthesisError",
+    "InfeasibleLMIError",
+    "CertificationError",
+]
+
+
+class HinfnavError(Exception):
+    """Base class of every error raised on purpose by hinfnav."""
+
+
+class InputError(HinfnavError, ValueError):
+    """A parameter has the wrong shape, type or value.
+
+    The message names the parameter and says what is wrong with it.
+    """
+
+
+class UnstablePlantError(InputError):
+    """The plant is not (robustly) Schur stable, so Lemma 1 cannot hold.
+
+    The error system (13) contains the plant state; its H-infinity norm is
+    finite only when the plant matrix ``A + ΔA`` is Schur stable for every
+    admissible uncertainty.
+    """
+
+
+class SynthesisError(HinfnavError):
+    """The LMI synthesis did not produce a usable filter."""
+
+
+class InfeasibleLMIError(SynthesisError):
+    """The solver found LMI (20) infeasible (the message carries its status)."""
+
+
+class CertificationError(SynthesisError):
+    """The filter rebuilt from the solver's solution fails independent verification."""

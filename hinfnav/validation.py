@@ -1,0 +1,102 @@
+"""Input checks shared by the public functions.
+
+Each check raises :class:`hinfnav.exceptions.InputError` naming the parameter
+and what is wrong with it, before any numerical work starts.
+"""
+
+import numbers
+
+import numpy as np
+
+from .exceptions import InputError
+
+__all__ = ["as_matrix", "as_vector", "as_real", "as_positive", "as_nonnegative", "as_int_at_least", "as_choice"]
+
+
+def _as_float_array(name, value):
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be an array of real numbers; got {type(value).__name__} ({exc})") from None
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"{name} must contain only finite numbers; it has NaN or inf entries")
+    return arr
+
+
+def as_matrix(name, value, shape=None):
+    """Return ``value`` as a finite 2-D float array, checking its shape.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name used in the error message.
+    value : array_like
+        The matrix.
+    shape : tuple of (int or None), optional
+        Expected shape; ``None`` in a slot accepts any size there.
+    """
+    arr = _as_float_array(name, value)
+    if arr.ndim != 2:
+        raise InputError(f"{name} must be a 2-D matrix; got an array with {arr.ndim} dimension(s), shape {arr.shape}")
+    if shape is not None:
+        for got, want in zip(arr.shape, shape):
+            if want is not None and got != want:
+                want_txt = "x".join("any" if s is None else str(s) for s in shape)
+                raise InputError(f"{name} must have shape {want_txt}; got {arr.shape[0]}x{arr.shape[1]}")
+    return arr
+
+
+def as_vector(name, value, size=None):
+    """Return ``value`` as a finite 1-D float array of length ``size``."""
+    arr = _as_float_array(name, value)
+    if arr.ndim != 1:
+        raise InputError(f"{name} must be a 1-D vector; got shape {arr.shape}")
+    if size is not None and arr.size != size:
+        raise InputError(f"{name} must have {size} entries; got {arr.size}")
+    return arr
+
+
+def _as_real(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError(f"{name} must be a real number; got {value!r}")
+    value = float(value)
+    if not np.isfinite(value):
+        raise InputError(f"{name} must be finite; got {value}")
+    return value
+
+
+def as_positive(name, value):
+    """Return ``value`` as a finite float > 0."""
+    value = _as_real(name, value)
+    if value <= 0:
+        raise InputError(f"{name} must be > 0; got {value}")
+    return value
+
+
+def as_nonnegative(name, value):
+    """Return ``value`` as a finite float >= 0."""
+    value = _as_real(name, value)
+    if value < 0:
+        raise InputError(f"{name} must be >= 0; got {value}")
+    return value
+
+
+def as_real(name, value):
+    """Return ``value`` as a finite float."""
+    return _as_real(name, value)
+
+
+def as_int_at_least(name, value, minimum):
+    """Return ``value`` as an int >= ``minimum``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise InputError(f"{name} must be an integer; got {value!r}")
+    if value < minimum:
+        raise InputError(f"{name} must be >= {minimum}; got {value}")
+    return int(value)
+
+
+def as_choice(name, value, choices):
+    """Return ``value`` if it is one of ``choices``, else raise naming the valid ones."""
+    if value not in choices:
+        raise InputError(f"unknown {name} {value!r}; choose one of: {', '.join(map(str, choices))}")
+    return value
