@@ -19,7 +19,7 @@ seed gives the same numbers, whatever the batch size.
 from dataclasses import dataclass, field
 
 import numpy as np
-from tqdm.auto import tqdm
+from tqdm import tqdm
 
 from .estimators import EstimateHistory, Estimator
 from .exceptions import InputError
