@@ -6,6 +6,7 @@ satellite based on robust H∞ filtering", Journal of Astronautics 32(7),
 1462–1470, 2011 (DOI 10.3873/j.issn.1000-1328.2011.07.005).
 """
 
+from .ekf import EKF, build_ekf, position_from_range_angles, range_angle_measurements, range_angles
 from .estimators import EstimateHistory, Estimator, LTIFilter
 from .exceptions import (
     CertificationError,
@@ -16,6 +17,7 @@ from .exceptions import (
     UnstablePlantError,
 )
 from .filters import FILTER_NAMES, make_estimator
+from .kalman import KalmanLimit, kalman_limit, lti_error_covariance, steady_state_kalman
 from .metrics import convergence_time, max_error, monte_carlo_summary, rms_error, rms_per_run
 from .models import UncertainSystem, discretize, hill_matrices, uncertainty_F, uncertainty_structure
 from .noise import NOISE_NAMES, make_noise
@@ -40,6 +42,15 @@ __all__ = [
     "EstimateHistory",
     "LTIFilter",
     "make_estimator",
+    "EKF",
+    "build_ekf",
+    "range_angles",
+    "range_angle_measurements",
+    "position_from_range_angles",
+    "kalman_limit",
+    "KalmanLimit",
+    "steady_state_kalman",
+    "lti_error_covariance",
     "FILTER_NAMES",
     "simulate",
     "simulate_truth",

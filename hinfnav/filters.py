@@ -9,6 +9,7 @@ name                       estimator
                            the filter assumes u = K x
 ``designed``               the filter from :func:`hinfnav.synthesize` at the
                            scenario's δ̄, told the applied thrust
+``designed_closed_loop``   the same run exactly as (12)
 ``ekf``                    the EKF of :mod:`hinfnav.ekf`, as the paper describes
                            it (does not know the control law)
 ``ekf_known_input``        the EKF told the applied thrust
@@ -21,7 +22,7 @@ from .validation import as_choice
 
 __all__ = ["FILTER_NAMES", "make_estimator", "lti_from_matrices"]
 
-FILTER_NAMES = ("published", "published_closed_loop", "designed", "ekf", "ekf_known_input")
+FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "ekf", "ekf_known_input")
 
 
 def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
@@ -37,6 +38,15 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
     uses_input : bool
         Tell the filter the applied thrust (the default); False runs (12)
         as printed, assuming u = K x.
+
+    Notes
+    -----
+    The thrust correction ``C_F⁻¹ T G₀ (u − K ẑ)`` is exact for a filter in
+    observer form (``C_F A_F C_F⁻¹ = A − C_F B_F C``), as the published one
+    nearly is (residual 3.5e-4). A filter far from that form (the LMI optimum
+    of Corollary 1 is not constrained to it) is only approximately corrected,
+    and without maneuver it has no guarantee at all: Lemma 1 needs the
+    closed-loop plant it was designed on (see notebook 04).
     """
     if uses_input:
         return LTIFilter(A_F, B_F, C_F, dt=scenario.dt, name=name, input_matrix=scenario.input_matrix_design(), K=scenario.K)
@@ -60,11 +70,11 @@ def make_estimator(name, scenario=None, **options):
     if name in ("published", "published_closed_loop"):
         pub = published_filter()
         return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"))
-    if name == "designed":
+    if name in ("designed", "designed_closed_loop"):
         from .synthesis import design_for_scenario
 
         res = design_for_scenario(scenario, **options)
-        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name)
+        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=(name == "designed"))
     from .ekf import build_ekf
 
     return build_ekf(scenario, known_input=(name == "ekf_known_input"), **options)

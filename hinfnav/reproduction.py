@@ -13,7 +13,10 @@ Conventions (the paper does not state them; see the notebooks for why):
   interval of that mean, and the 2.5–97.5 % spread of single runs;
 * noise: white Gaussian w, v (the paper's Table 1 text), Fig 7 with the
   Gaussian mixture of paper 001 and δ = 1;
-* all filters see the same truth and measurements in each case.
+* all filters see the same truth and measurements in each case;
+* the H∞ filters run exactly as (12) with maneuver (the closed loop u = Kx
+  they were designed on) and are told the applied thrust without maneuver
+  (see :func:`hinfnav.filters.lti_from_matrices`).
 """
 
 import csv
@@ -79,14 +82,18 @@ def _axes_rms(values):
     return float(np.sqrt(np.mean(np.square(values))))
 
 
-def _estimators(scenario, designed):
+def _estimators(scenario, designed, maneuver):
+    """The filters of the table; H∞ filters verbatim (12) with maneuver, told the thrust without."""
+    pub = published_filter()
+    told = not maneuver
     est = {
         "ekf": make_estimator("ekf", scenario),
         "ekf_known_input": make_estimator("ekf_known_input", scenario),
-        "hinf_published": make_estimator("published", scenario),
+        "hinf_published": lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name="published", uses_input=told),
     }
     if designed is not None:
-        est["hinf_designed"] = lti_from_matrices(designed.A_F, designed.B_F, designed.C_F, scenario, name="designed")
+        est["hinf_designed"] = lti_from_matrices(designed.A_F, designed.B_F, designed.C_F, scenario, name="designed",
+                                                 uses_input=told)
     return est
 
 
@@ -161,15 +168,14 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, progress=False):
     runs = as_int_at_least("runs", runs, 1)
     if designed is None:
         designed = design_for_scenario(scenario, delta_bar=0.05)
-    estimators = _estimators(scenario, designed)
     win = scenario.rms_window_s
     cells, ekf_windows, klim = {}, {}, {}
-    total = len(CASES) * len(estimators)
+    total = len(CASES) * len(_estimators(scenario, designed, True))
     with tqdm(total=total, disable=not progress, desc="Table 1", unit="filter") as bar:
         for case, maneuver in CASES.items():
             truth = simulate_truth(scenario, maneuver=maneuver, runs=runs, seed=seed)
             cells[case] = {}
-            for key, est in estimators.items():
+            for key, est in _estimators(scenario, designed, maneuver).items():
                 res = run_estimator(est, truth, scenario.xhat0)
                 cells[case][key] = _cell(res, truth.t, win)
                 if case == "maneuver" and key == "ekf":
@@ -179,7 +185,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, progress=False):
                 bar.update(1)
             for key, paper_key in (("paper_ekf", "ekf"), ("paper_hinf", "hinf")):
                 cells[case][key] = dict(PAPER_TABLE1[case][paper_key])
-            klim[case] = kalman_limit(scenario, maneuver=maneuver)
+            klim[case] = kalman_limit(scenario, maneuver=maneuver).as_dict()
     settings = {
         "runs": runs,
         "seed": seed,
@@ -192,24 +198,23 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, progress=False):
             "per-axis RMS of x - xhat over window_s; a cell is the RMS over x, y, z of the per-axis values; "
             "pos_m/vel_mps: single run (run 0, as the paper reports); mc_*: over all runs"
         ),
+        "hinf_input": "H-inf filters run verbatim as (12) with maneuver, told the applied thrust without",
         "designed_gamma": float(designed.gamma),
         "designed_lmi_gamma": float(designed.lmi_gamma),
     }
     return Table1(cells=cells, ekf_windows=ekf_windows, kalman_limit=klim, settings=settings)
 
 
-def _kl_axes(kl):
-    """(pos_m, vel_mps) scalar (RMS over axes) of a kalman_limit record, filtered values."""
-    pos = np.asarray(kl["filtered_pos_m"])
-    vel = np.asarray(kl["filtered_vel_mps"])
-    return _axes_rms(pos), _axes_rms(vel)
+def _kl_axes(kl, predicted=False):
+    """(pos_m, vel_mps) scalars (RMS over axes) of a kalman_limit record (filtered or predicted)."""
+    suffix = "_predicted" if predicted else ""
+    return _axes_rms(kl["pos_m" + suffix]), _axes_rms(kl["vel_mps" + suffix])
 
 
 def table1_rows(tab):
     """Rows (list of dicts) of the reproduced table, paper values beside them."""
     rows = []
     for case in CASES:
-        kp, kv = _kl_axes(tab.kalman_limit[case])
         for key, label in [("paper_ekf", "paper: EKF"), ("paper_hinf", "paper: H∞")] + list(TABLE_FILTERS.items()):
             c = tab.cells[case].get(key)
             if c is None:
@@ -221,7 +226,9 @@ def table1_rows(tab):
                     mc_vel_mps=c["mc_mean_vel_mps"], mc_vel_ci95=c["mc_ci95_vel_mps"],
                 )
             rows.append(row)
-        rows.append({"case": case.replace("_", " "), "filter": "Kalman limit (steady-state Riccati)", "pos_m": kp, "vel_mps": kv})
+        for predicted, label in ((False, "Kalman limit, filtered (uses y(k))"), (True, "Kalman limit, predicted (y up to k-1, like (12))")):
+            kp, kv = _kl_axes(tab.kalman_limit[case], predicted)
+            rows.append({"case": case.replace("_", " "), "filter": label, "pos_m": kp, "vel_mps": kv})
     return rows
 
 
@@ -383,6 +390,7 @@ def _summary(tab, designed, fig7_res, scenario):
         for key, c in tab.cells[case].items():
             t1[case][key] = c
     kp, kv = _kl_axes(tab.kalman_limit["no_maneuver"])
+    kpp, kvp = _kl_axes(tab.kalman_limit["no_maneuver"], predicted=True)
     win = scenario.rms_window_s
     per = rms_per_run(fig7_res.error, fig7_res.t, win)[0]
     return {
@@ -392,8 +400,11 @@ def _summary(tab, designed, fig7_res, scenario):
         "kalman_limit": {
             "pos_m": kp,
             "vel_mps": kv,
-            "note": "steady-state Kalman filter (Riccati) error, filtered, no maneuver, RMS over axes; "
-            "per case and per axis below",
+            "pos_m_predicted": kpp,
+            "vel_mps_predicted": kvp,
+            "note": "steady-state Kalman filter (Riccati) error for the stated white noise, no maneuver, RMS over "
+            "axes; pos_m/vel_mps filtered (uses y(k), like the EKF), *_predicted one step ahead (like the H-inf "
+            "filter (12)); per case and per axis under 'cases' (with maneuver: a filter that knows u = Kx)",
             "cases": tab.kalman_limit,
         },
         "ekf_maneuver_windows": tab.ekf_windows,

@@ -1,0 +1,45 @@
+"""Benchmark: Monte Carlo simulation speed, vectorized vs run by run.
+
+Run: ``python benchmarks/bench_simulation.py [--runs N]``. Prints times and
+ratios; it asserts nothing (speed is not a test).
+"""
+
+import argparse
+import time
+
+import numpy as np
+
+import hinfnav as hn
+
+
+def _time(fn, repeat=3):
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--runs", type=int, default=100, help="Monte Carlo runs (default 100)")
+    args = p.parse_args(argv)
+    s = hn.Scenario()
+    print(f"scenario: {s.n_steps} steps of T = {s.dt} s, {args.runs} runs")
+    rows = []
+    for name in ("published", "ekf", "ekf_known_input"):
+        est = hn.make_estimator(name, s)
+        vec = _time(lambda: hn.simulate(s, est, runs=args.runs, seed=0, batch_size=args.runs), repeat=2)
+        loop = _time(lambda: hn.simulate(s, est, runs=min(args.runs, 10), seed=0, batch_size=1), repeat=1)
+        loop *= args.runs / min(args.runs, 10)
+        rows.append((name, vec, loop))
+    print(f"{'filter':18}{'vectorized (s)':>16}{'run by run (s)':>16}{'ratio':>8}")
+    for name, vec, loop in rows:
+        print(f"{name:18}{vec:16.2f}{loop:16.2f}{loop / vec:8.1f}")
+    truth = _time(lambda: hn.simulate_truth(s, runs=args.runs, seed=0), repeat=2)
+    print(f"truth alone: {truth:.2f} s for {args.runs} runs ({1e3 * truth / args.runs:.1f} ms per run)")
+
+
+if __name__ == "__main__":
+    main()
