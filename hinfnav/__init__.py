@@ -23,6 +23,15 @@ from .models import UncertainSystem, discretize, hill_matrices, uncertainty_F, u
 from .noise import NOISE_NAMES, make_noise
 from .scenario import Scenario, infer_sampling_time, published_filter
 from .simulation import SimulationResult, simulate, simulate_truth
+from .synthesis import (
+    GammaSweep,
+    SynthesisResult,
+    compare_with_published,
+    design_for_scenario,
+    design_report,
+    gamma_sweep,
+    synthesize,
+)
 
 __version__ = "0.1.0"
 
@@ -52,6 +61,13 @@ __all__ = [
     "steady_state_kalman",
     "lti_error_covariance",
     "FILTER_NAMES",
+    "synthesize",
+    "SynthesisResult",
+    "design_for_scenario",
+    "gamma_sweep",
+    "GammaSweep",
+    "design_report",
+    "compare_with_published",
     "simulate",
     "simulate_truth",
     "SimulationResult",

@@ -1,0 +1,341 @@
+"""Tests of hinfnav.synthesis: Theorem 1 / Corollary 1, certified."""
+
+import json
+
+import numpy as np
+import pytest
+
+import hinfnav.synthesis as synthesis
+from hinfnav.exceptions import (
+    CertificationError,
+    HinfnavError,
+    InfeasibleLMIError,
+    InputError,
+    UnstablePlantError,
+)
+from hinfnav.hinfnorm import (
+    hinf_norm,
+    hinf_norm_bisection,
+    schur_gamma,
+    spectral_radius,
+    worst_case_norm,
+)
+from hinfnav.models import UncertainSystem, hill_matrices, uncertainty_F
+from hinfnav.scenario import Scenario, published_filter
+from hinfnav.synthesis import (
+    compare_with_published,
+    delta_grid,
+    design_for_scenario,
+    design_report,
+    format_design_report,
+    gamma_sweep,
+    lmi20_matrix,
+    observer_form,
+    prepare_uncertainty,
+    synthesize,
+)
+
+
+@pytest.fixture(scope="module")
+def paper_design():
+    """The δ̄ = 0.05 design of the paper's scenario (shared: ~0.6 s)."""
+    return design_for_scenario(Scenario(), 0.05)
+
+
+# --------------------------------------------------------------------------- known answers
+
+
+@pytest.mark.parametrize("a, b, l", [(0.5, 1.0, 1.0), (0.9, 0.3, 2.0), (-0.6, 1.0, 1.0)])
+def test_no_measurement_information_known_answer(a, b, l):
+    # C = 0: y = D v carries no information, so the best filter outputs z_f = 0 and
+    # γ* = ‖L(zI − A)⁻¹B‖∞ = |l b|/(1 − |a|) (closed form: any use of y only adds the v channel)
+    res = synthesize([[a]], [[b]], [[0.0]], [[1.0]], [[l]])
+    expected = abs(l * b) / (1 - abs(a))
+    assert res.gamma == pytest.approx(expected, rel=1e-5)
+    assert res.gamma >= expected * (1 - 1e-9)  # a certified bound is never below the optimum
+    assert res.verified_norm <= res.gamma
+
+
+@pytest.mark.parametrize("a, b", [(0.5, 1.0), (0.9, 0.3)])
+def test_noise_free_measurement_known_answer(a, b):
+    # C = 1, D = 0, L = 1: the strictly proper filter (12) sees y up to k − 1, so e(k) keeps
+    # b w(k − 1): γ* = |b| (closed form), reached by z_f(k) = a y(k − 1)
+    res = synthesize([[a]], [[b]], [[1.0]], [[0.0]], [[1.0]])
+    assert res.gamma == pytest.approx(abs(b), rel=1e-5)
+    # the optimal filter predicts a·y: C_F (zI − A_F)⁻¹ B_F ≈ a/z
+    tf = res.C_F @ np.linalg.solve(2.0 * np.eye(1) - res.A_F, res.B_F)
+    assert tf[0, 0] == pytest.approx(a / 2.0, rel=1e-4)
+
+
+@pytest.mark.parametrize("a, h, e", [(0.5, 0.2, 1.0), (0.6, 1.0, 0.3)])
+def test_uncertain_scalar_known_answer(a, h, e):
+    # C = 0 again, x⁺ = (a + h f e) x + w: the worst admissible f is +1 (positive system), so
+    # γ* = 1/(1 − a − |h e|) (closed form); Lemma 2 is lossless for one scalar uncertainty
+    res = synthesize([[a]], [[1.0]], [[0.0]], [[1.0]], [[1.0]], [[h]], [[e]])
+    assert res.gamma == pytest.approx(1 / (1 - a - abs(h * e)), rel=1e-5)
+    assert res.verified_norm == pytest.approx(1 / (1 - a - abs(h * e)), rel=1e-6)  # F = +1 is sampled
+
+
+def _random_uncertain(rng, n=3, p=2, m=2, q=2, l=2, r=2, rho=0.8, size=0.1):
+    A = rng.standard_normal((n, n))
+    A *= rho / spectral_radius(A)
+    B, C, D, L = (rng.standard_normal(s) for s in [(n, p), (m, n), (m, q), (l, n)])
+    H = rng.standard_normal((n, r))
+    E = rng.standard_normal((r, n))
+    H *= np.sqrt(size) / np.linalg.norm(H, 2)
+    E *= np.sqrt(size) / np.linalg.norm(E, 2)
+    return A, B, C, D, L, H, E
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_uncertain_systems_are_certified(seed):
+    # every returned filter must satisfy Theorem 1's guarantee on F it was never checked at,
+    # by an independent norm algorithm; otherwise a named error is acceptable
+    rng = np.random.default_rng(seed)
+    A, B, C, D, L, H, E = _random_uncertain(rng, size=[0.02, 0.1, 0.3][seed % 3])
+    try:
+        res = synthesize(A, B, C, D, L, H, E, seed=rng)
+    except (InfeasibleLMIError, CertificationError, UnstablePlantError) as exc:
+        assert str(exc)
+        return
+    assert res.verified_norm <= res.gamma
+    assert res.spectral_radius < 1
+    system = UncertainSystem(A, B, C, D, L, H, E)
+    fresh = []
+    for _ in range(10):
+        F = rng.standard_normal((2, 2))
+        fresh.append(F / (np.linalg.norm(F, 2) * rng.uniform(1.0, 1.3)))
+    wc = worst_case_norm(system, res.A_F, res.B_F, res.C_F, fresh)
+    assert wc.stable
+    assert wc.norm <= res.gamma
+    sys0 = res.error_system(system, fresh[0])
+    assert hinf_norm_bisection(sys0) == pytest.approx(hinf_norm(sys0), rel=1e-8)
+    assert hinf_norm(sys0) <= res.gamma
+
+
+def test_lmi20_holds_at_returned_unscaled_variables(paper_design):
+    # LMI (20) evaluated in float64 with the plant data and the returned variables (original state
+    # coordinates, balanced H, E) is negative definite at the returned γ: a solver-free check
+    res = paper_design
+    s = Scenario().design_model(0.05)
+    v = res.variables
+    M0 = lmi20_matrix(s.A, s.B, s.C, s.D, s.L, v["H"], v["E"], v["R"], v["S"], v["Abar_F"], v["Bbar_F"], v["Cbar_F"], v["lam"], 0.0)
+    n, p, q = 6, 6, 3
+    gamma, _ = schur_gamma(M0, np.arange(4 * n, 4 * n + p + q))
+    assert gamma == pytest.approx(res.gamma, rel=1e-6)
+    # (21): A_F = S⁻¹ Ā_F, B_F = S⁻¹ B̄_F, C_F = C̄_F
+    np.testing.assert_allclose(np.linalg.solve(v["S"], v["Abar_F"]), res.A_F, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(v["Cbar_F"], res.C_F)
+
+
+def test_state_scaling_is_exact_powers_of_two(paper_design):
+    # the internal coordinates x = Σ x̃ use powers of two, so unscaling is exact
+    P = synthesis._prepare(Scenario().design_model(0.05), "diagonal", "balance")
+    assert np.all(np.log2(P.sigma) == np.round(np.log2(P.sigma)))
+    assert not np.all(P.sigma == 1)
+
+
+def test_prepare_uncertainty_drops_zero_columns_and_balances():
+    # paper's H_a, E_a: columns 1 and 5 of H_a (rows of E_a) are zero (Section 4)
+    s = Scenario().design_model(0.05)
+    Hb, Eb, (kh, ke) = prepare_uncertainty(s.H, s.E, "diagonal")
+    assert list(kh) == [0, 2, 3, 4]
+    # H diag(s) F diag(s)⁻¹ E = H F E for diagonal F (identity, to round-off)
+    for d in (-0.05, 0.03):
+        F = uncertainty_F(d, 0.05)
+        np.testing.assert_allclose(Hb @ F[np.ix_(kh, kh)] @ Eb, s.H @ F @ s.E, rtol=1e-12, atol=1e-20)
+    # balanced: ‖H_j‖ and ‖E_j‖ within a factor 2 (powers of two)
+    ratio = np.linalg.norm(Hb, axis=0) / np.linalg.norm(Eb, axis=1)
+    assert np.all((ratio >= 0.5) & (ratio <= 2.0))
+    Hf, Ef, (kh, ke) = prepare_uncertainty(s.H, s.E, "full")
+    assert Hf.shape == (6, 4) and Ef.shape == (4, 6)
+    # a common scalar only
+    np.testing.assert_allclose(Hf @ Ef, s.H[:, kh] @ s.E[ke, :], rtol=1e-12, atol=1e-20)
+
+
+# --------------------------------------------------------------------------- the paper's system
+
+
+def test_paper_design_is_certified(paper_design):
+    res = paper_design
+    assert res.delta_bar == 0.05
+    assert 0.05 in res.deltas and -0.05 in res.deltas and 0.0 in res.deltas
+    assert res.verified_norm <= res.gamma
+    assert res.spectral_radius < 1
+    # the certified γ and the solver's agree to 1e-4 (rtol of the synthesis)
+    assert res.gamma == pytest.approx(res.lmi_gamma, rel=1e-4)
+    # independent recomputation of the sampled worst case at the vertices (slycot and BBBS)
+    s = Scenario().design_model(0.05)
+    for d in (-0.05, 0.05):
+        sys = res.error_system(s, uncertainty_F(d, 0.05))
+        assert hinf_norm_bisection(sys) <= res.gamma
+    ss = res.statespace()
+    assert ss.dt == 0.1 and ss.nstates == 6
+
+
+def test_solvers_agree_and_gamma_nondecreasing(paper_design):
+    # Clarabel alone vs the default (Clarabel, CVXOPT polish): same optimum to 1e-4
+    sc = Scenario()
+    clar = design_for_scenario(sc, 0.05, solver="CLARABEL")
+    assert clar.gamma == pytest.approx(paper_design.gamma, rel=1e-4)
+    assert clar.solver == "CLARABEL"
+    sweep = gamma_sweep([0.0, 0.05, 1.0], sc)
+    assert sweep.nondecreasing
+    g0, g05, g1 = sweep.gammas
+    assert g0 < g05 < g1
+    # at δ̄ = 0 the certified γ is the filter's own norm (Lemma 1 is exact) to 1e-6
+    assert sweep.results[0].verified_norm == pytest.approx(g0, rel=1e-6)
+    assert sweep.results[1].gamma == pytest.approx(paper_design.gamma, rel=1e-5)
+    rows = sweep.table()
+    assert [r["delta_bar"] for r in rows] == [0.0, 0.05, 1.0]
+
+
+def test_design_report_is_json_ready():
+    rep = design_report(0.01)
+    text = json.dumps(rep)
+    back = json.loads(text)
+    for key in ("delta_bar", "gamma", "lmi_gamma", "solver", "solve_time_s", "A_F", "B_F", "C_F", "verified_norm", "worst_delta"):
+        assert key in back
+    assert np.asarray(back["A_F"]).shape == (6, 6)
+    assert np.asarray(back["B_F"]).shape == (6, 3)
+    assert back["verified_norm"] <= back["gamma"]
+    txt = format_design_report(rep)
+    assert "certified γ" in txt and "A_F =" in txt
+
+
+def test_compare_with_published(paper_design):
+    cmp = compare_with_published(design=paper_design)
+    pub, opt = cmp["published"], cmp["optimal"]
+    # the published filter's norm, recomputed independently (BBBS on its nominal error system)
+    sc = Scenario()
+    s = sc.design_model(0.05)
+    pf = published_filter()
+    from hinfnav.hinfnorm import error_system
+
+    g_pub = hinf_norm_bisection(error_system(s.A, s.B, s.C, s.D, s.L, pf.A_F, pf.B_F, pf.C_F, sc.dt))
+    assert pub["nominal_norm"] == pytest.approx(g_pub, rel=1e-8)
+    # the robust bound (all F) is never below the sampled worst case
+    assert pub["robust_bound"] >= pub["worst_norm"] * (1 - 1e-9)
+    assert opt["robust_bound"] >= opt["worst_norm"] * (1 - 1e-9)
+    # the published filter is in observer form (residual at print precision) with G ≈ [1.61 I; 6.13 I]
+    assert pub["observer_residual"] < 1e-3
+    np.testing.assert_allclose(np.diag(pub["observer_gain"][:3]), 1.61, atol=0.01)
+    np.testing.assert_allclose(np.diag(pub["observer_gain"][3:]), 6.1, atol=0.05)
+    assert cmp["ratio"] > 2.0
+
+
+def test_observer_form_of_exact_observer():
+    # a filter built as x̂⁺ = A x̂ + G(y − C x̂) with C_F = −I has residual 0 and returns G (construction)
+    rng = np.random.default_rng(2)
+    A, C, G = rng.standard_normal((3, 3)), rng.standard_normal((1, 3)), rng.standard_normal((3, 1))
+    CF = -np.eye(3)
+    A_F = np.linalg.solve(CF, (A - G @ C) @ CF)
+    B_F = np.linalg.solve(CF, G)
+    out = observer_form(A_F, B_F, CF, A, C)
+    np.testing.assert_allclose(out["G"], G, rtol=1e-12)
+    assert out["residual"] < 1e-12
+
+
+def test_delta_grid_contains_vertices_and_zero():
+    g = delta_grid(0.2, 4)
+    assert g[0] == -0.2 and g[-1] == 0.2 and 0.0 in g
+    assert list(delta_grid(0.0)) == [0.0]
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+def test_shape_mismatch_names_parameter():
+    with pytest.raises(InputError, match="B must have shape 2x"):
+        synthesize(np.eye(2) * 0.5, np.ones((3, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
+    with pytest.raises(InputError, match="D must have shape 1x"):
+        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((2, 1)), np.eye(2))
+    with pytest.raises(InputError, match="E must have shape"):
+        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2), np.ones((2, 1)), np.ones((2, 2)))
+
+
+def test_non_finite_entries_name_parameter():
+    A = np.eye(2) * 0.5
+    A[0, 1] = np.inf
+    with pytest.raises(InputError, match="A must contain only finite"):
+        synthesize(A, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
+    with pytest.raises(InputError, match="L must contain only finite"):
+        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), [[np.nan, 0], [0, 1]])
+
+
+def test_h_without_e_and_bad_options():
+    args = (np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
+    with pytest.raises(InputError, match="H and E"):
+        synthesize(*args, H=np.ones((2, 1)))
+    with pytest.raises(InputError, match="solver"):
+        synthesize(*args, solver="MOSEKX")
+    with pytest.raises(InputError, match="dt"):
+        synthesize(*args, dt=-1.0)
+    with pytest.raises(InputError, match="structure"):
+        synthesize(*args, structure="block")
+    with pytest.raises(InputError, match=r"uncertainty_samples\[0\] must be a contraction"):
+        synthesize(*args, H=np.ones((2, 1)) * 0.1, E=np.ones((1, 2)) * 0.1, uncertainty_samples=[[[2.0]]])
+    with pytest.raises(InputError, match=r"uncertainty_samples\[0\] must be diagonal"):
+        synthesize(*args, H=np.eye(2) * 0.1, E=np.eye(2) * 0.1, structure="diagonal", uncertainty_samples=[[[0.5, 0.5], [0, 0]]])
+
+
+def test_no_maneuver_hill_model_is_rejected_with_explanation():
+    # the unforced Hill model (A = I + T A₁) has spectral radius ≥ 1: Lemma 1 cannot hold
+    sc = Scenario()
+    A1, _ = hill_matrices(sc.omega0, sc.mass)
+    A = np.eye(6) + sc.dt * A1
+    s = sc.design_model(0.0)
+    with pytest.raises(UnstablePlantError) as info:
+        synthesize(A, s.B, s.C, s.D, s.L)
+    msg = str(info.value)
+    for phrase in ("Lemma 1", "plant state", "no finite γ", "no-maneuver", "u = Kx"):
+        assert phrase in msg
+
+
+def test_plant_unstable_at_a_vertex_is_rejected():
+    # stable nominally (0.9) but a + h e = 1.1 at F = +1 (a sampled vertex)
+    with pytest.raises(UnstablePlantError, match=r"sample \d+"):
+        synthesize([[0.9]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[0.2]], [[1.0]])
+
+
+def test_infeasible_lmi_carries_solver_status():
+    # 0.5 + f with |f| ≤ 1 reaches 1.5: no quadratic Lyapunov function exists, but only F = 0 is
+    # sampled, so the plant check passes and the LMI itself must report infeasibility
+    with pytest.raises(InfeasibleLMIError, match="status"):
+        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], uncertainty_samples=[[[0.0]]])
+
+
+def test_certification_failure_is_reported(monkeypatch):
+    # if no solution survives the checks, CertificationError says why
+    def refuse(P, sol, system, samples, dt):
+        return synthesis._Check(False, "forced refusal for the test")
+
+    monkeypatch.setattr(synthesis, "_rebuild_and_certify", refuse)
+    with pytest.raises(CertificationError, match="forced refusal"):
+        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], method="minimize")
+
+
+def test_errors_share_the_base_class():
+    assert issubclass(InfeasibleLMIError, HinfnavError) and issubclass(CertificationError, HinfnavError)
+
+
+def test_plots_return_artists_and_label_axes(paper_design):
+    # object API only: a bare Figure, no pyplot state
+    from matplotlib.figure import Figure
+
+    from hinfnav import synthesis_plots
+    from hinfnav.synthesis import GammaSweep
+
+    fig = Figure()
+    axes = fig.subplots(2, 3)
+    sweep = GammaSweep(np.array([0.05]), (paper_design,))
+    system = Scenario().design_model(0.05)
+    assert synthesis_plots.plot_gamma_curve(sweep, ax=axes[0, 0])
+    assert "δ̄" in axes[0, 0].get_xlabel()
+    arts = synthesis_plots.plot_sigma(paper_design.error_system(system), ax=axes[0, 1], gamma=paper_design.gamma, label="x")
+    assert len(arts) >= 3 and "rad/s" in axes[0, 1].get_xlabel()
+    assert synthesis_plots.plot_worst_case_over_delta(paper_design, ax=axes[0, 2])
+    imgs = synthesis_plots.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1])
+    assert len(imgs) == 6
+    with pytest.raises(InputError, match="axes"):
+        synthesis_plots.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1, :2])
