@@ -3,9 +3,12 @@
 Prints, for every δ̄ of the sweep, the certified γ*, the solver's γ, the worst
 sampled H∞ norm, the solver wall time and the total time (with
 certification), for the default solver chain (Clarabel, then CVXOPT polish)
-and for each solver alone; then the time of the whole sweep.
+and for each solver alone; then the time of the whole sweep. Both filter
+forms are run: ``general`` (LMI (20) as in the paper) and ``observer``
+(``C_F = −L``, ``A_F = A + B_F C`` imposed); a last table compares them
+(γ_observer / γ* and the residual of :func:`hinfnav.synthesis.observer_form`).
 
-Run: ``python benchmarks/bench_synthesis.py [--repeat N]`` (not a test).
+Run: ``python benchmarks/bench_synthesis.py [--repeat N] [--form general|observer|both]`` (not a test).
 """
 
 import argparse
@@ -14,17 +17,17 @@ import time
 import numpy as np
 
 from hinfnav.scenario import Scenario
-from hinfnav.synthesis import DEFAULT_DELTA_BARS, gamma_sweep
+from hinfnav.synthesis import DEFAULT_DELTA_BARS, gamma_sweep, observer_form
 
 
-def run(solver, repeat):
+def run(solver, repeat, form="general"):
     label = solver or "default (CLARABEL + CVXOPT)"
-    print(f"\n== solver: {label} ==")
+    print(f"\n== form: {form}, solver: {label} ==")
     print(f"{'δ̄':>6} {'γ* certified':>14} {'solver γ':>14} {'worst ‖Ψ‖∞':>14} {'used':>9} {'method':>9} {'solve s':>8} {'total s':>8}")
     best = None
     for _ in range(repeat):
         t0 = time.perf_counter()
-        sweep = gamma_sweep(DEFAULT_DELTA_BARS, Scenario(), solver=solver)
+        sweep = gamma_sweep(DEFAULT_DELTA_BARS, Scenario(), solver=solver, form=form)
         wall = time.perf_counter() - t0
         if best is None or wall < best[0]:
             best = (wall, sweep)
@@ -40,12 +43,31 @@ def run(solver, repeat):
     return sweep
 
 
+def compare(general, observer):
+    sc = Scenario()
+    print("\n== observer form against the general optimum (default solver chain) ==")
+    print(f"{'δ̄':>6} {'γ* general':>12} {'γ observer':>12} {'excess':>9} {'residual gen':>13} {'residual obs':>13}")
+    for d, g, o in zip(general.delta_bars, general.results, observer.results):
+        s = sc.design_model(d)
+        res_g = observer_form(g.A_F, g.B_F, g.C_F, s.A, s.C)["residual"]
+        res_o = observer_form(o.A_F, o.B_F, o.C_F, s.A, s.C)["residual"]
+        print(f"{d:6.2f} {g.gamma:12.8f} {o.gamma:12.8f} {o.gamma / g.gamma - 1:9.3%} {res_g:13.3e} {res_o:13.3e}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=1, help="repetitions; the fastest is reported (default 1)")
+    parser.add_argument("--form", choices=("general", "observer", "both"), default="both", help="filter form(s) (default both)")
     args = parser.parse_args()
-    for solver in (None, "CLARABEL", "CVXOPT"):
-        run(solver, args.repeat)
+    forms = ("general", "observer") if args.form == "both" else (args.form,)
+    default = {}
+    for form in forms:
+        for solver in (None, "CLARABEL", "CVXOPT"):
+            sweep = run(solver, args.repeat, form)
+            if solver is None:
+                default[form] = sweep
+    if len(default) == 2:
+        compare(default["general"], default["observer"])
 
 
 if __name__ == "__main__":

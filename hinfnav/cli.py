@@ -5,6 +5,7 @@ Run ``python -m hinfnav COMMAND --help`` for each command's options.
 
 import argparse
 import json
+import os
 import sys
 
 import numpy as np
@@ -88,7 +89,7 @@ def _cmd_simulate(args):
 def _cmd_design(args):
     from .synthesis import design_report, format_design_report
 
-    rep = design_report(args.delta_bar, solver=args.solver)
+    rep = design_report(args.delta_bar, solver=args.solver, form=args.form)
     print(json.dumps(rep, indent=2) if args.json else format_design_report(rep))
 
 
@@ -101,6 +102,7 @@ def _cmd_reproduce(args):
 def _parser():
     from .filters import FILTER_NAMES
     from .noise import NOISE_NAMES
+    from .synthesis import SOLVERS
 
     p = argparse.ArgumentParser(
         prog="python -m hinfnav",
@@ -122,7 +124,11 @@ def _parser():
 
     d = sub.add_parser("design", help="design a robust H-infinity filter by LMI (Corollary 1) and certify it")
     d.add_argument("--delta-bar", type=float, default=0.05, help="uncertainty bound delta_bar >= 0 (default 0.05)")
-    d.add_argument("--solver", default=None, help="SDP solver: CLARABEL (default) or CVXOPT")
+    d.add_argument("--solver", default=None, type=str.upper, choices=SOLVERS,
+                   help="SDP solver (default: CLARABEL, polished by CVXOPT; SCS works but is very slow)")
+    d.add_argument("--form", default="general", choices=("general", "observer"),
+                   help="filter structure: general (the paper's LMI (20), default) or observer "
+                        "(extension: error independent of the trajectory)")
     d.add_argument("--json", action="store_true", help="print one JSON object")
     d.set_defaults(func=_cmd_design)
 
@@ -153,4 +159,7 @@ def main(argv=None):
     except HinfnavError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2 if isinstance(exc, ValueError) else 1
+    except BrokenPipeError:
+        # output piped into e.g. `head`, which closed early: not an error of ours
+        sys.stdout = open(os.devnull, "w")
     return 0

@@ -39,6 +39,12 @@ Numerics (the paper's model is badly scaled: ω₀ ≈ 7e-5, uncertainty blocks
   solution for any γ is recognized by the γ-free part of (20) having no
   interior point (:class:`~hinfnav.exceptions.InfeasibleLMIError`).
 
+With ``form="observer"`` the filter is constrained to a predictor observer
+(``C_F = −L``, ``A_F = A + B_F C``; see :func:`synthesize`): its estimation
+error then does not depend on the plant trajectory, which the unconstrained
+optimum's does (it is not in observer form, and the H∞ bound assumes a zero
+initial state).
+
 The LMI is the paper's, with its single multiplier λ (Lemma 2). For the
 paper's diagonal F_Δa, balancing H and E channel by channel (the default of
 :func:`design_for_scenario`) changes which full-block contractions the LMI
@@ -63,10 +69,12 @@ from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, a
 
 __all__ = [
     "SOLVERS",
+    "FORMS",
     "DEFAULT_DELTA_BARS",
     "SynthesisResult",
     "GammaSweep",
     "lmi20_matrix",
+    "observer_lmi_matrix",
     "prepare_uncertainty",
     "default_uncertainty_samples",
     "synthesize",
@@ -82,6 +90,9 @@ __all__ = [
 
 #: Solvers :func:`synthesize` accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")
+
+#: Filter structures :func:`synthesize` accepts.
+FORMS = ("general", "observer")
 
 #: The δ̄ values of the design sweep (issue 3, item 6).
 DEFAULT_DELTA_BARS = (0.0, 0.01, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0)
@@ -158,6 +169,75 @@ def lmi20_matrix(A, B, C, D, L, H, E, R, S, Abar_F, Bbar_F, Cbar_F, lam, gamma2,
     return bmat(rows)
 
 
+def observer_lmi_matrix(A, B, C, D, L, H, E, X, S, Bbar_F, lam, gamma2, bmat=np.block):
+    """LMI (20) for an observer-form filter, in error coordinates (congruent to (20)).
+
+    With the observer constraints ``Ā_F = S A + B̄_F C`` and ``C̄_F = −L``
+    substituted, ``R = S + X``, and the congruence ``Tᵀ M T`` with
+    ``T = diag(T₀, T₀, I, I, I[, I])``, ``T₀ = [[I, 0], [−I, I]]`` (the change
+    of coordinates ``(x, x_f) → (x, e = x + x_f)``), LMI (20) becomes::
+
+        [ −X   0    XA         0         XB     0      0    XH  ]
+        [  *  −S    0        SA + B̄_F C  SB   B̄_F D    0    SH  ]
+        [  *   *   −X + λEᵀE   0          0     0      0    0   ]
+        [  *   *    *         −S          0     0      Lᵀ   0   ]
+        [  *   *    *          *        −γ²I    0      0    0   ]
+        [  *   *    *          *          *   −γ²I     0    0   ]
+        [  *   *    *          *          *     *     −I    0   ]
+        [  *   *    *          *          *     *      *  −λI   ]
+
+    It is negative definite iff (20) is (congruence with an invertible T),
+    at ``R = S + X``, ``Ā_F = S A + B̄_F C``, ``C̄_F = −L``. In these
+    coordinates the Lyapunov matrix ``[[R, S], [S, S]]`` of (20) is
+    ``diag(X, S)``: X weighs the plant state, S the estimation error, and
+    the two are coupled only through the uncertainty (H, E) and the common
+    −γ²I row of w. At δ̄ = 0 the infimum has X → 0 (the plant state does
+    not reach the error), a boundary of the feasible set. On the paper's
+    model, (20) with the constraints merely substituted makes Clarabel and
+    CVXOPT stop with numerical errors near the optimum (δ̄ = 0 … 5, γ off by
+    up to 6e-3 after bisection); on this form CVXOPT converges to ~1e-7.
+
+    Parameters
+    ----------
+    A, B, C, D, L, H, E
+        As in :func:`lmi20_matrix` (``L`` square); ``H = None`` for the
+        nominal LMI.
+    X, S : ndarray or cvxpy expression, shape (n, n)
+    Bbar_F : shape (n, m)
+    lam, gamma2 : float or cvxpy expression
+    bmat : callable, optional
+
+    Returns
+    -------
+    ndarray or cvxpy expression, same shape as :func:`lmi20_matrix`'s
+    """
+    n, p = B.shape
+    q = D.shape[1]
+    l = L.shape[0]
+    Z = np.zeros
+    I = np.eye
+    XA = X @ A
+    SA = S @ A + Bbar_F @ C
+    BD = Bbar_F @ D
+    rows = [
+        [-X, Z((n, n)), XA, Z((n, n)), X @ B, Z((n, q)), Z((n, l))],
+        [Z((n, n)), -S, Z((n, n)), SA, S @ B, BD, Z((n, l))],
+        [XA.T, Z((n, n)), -X, Z((n, n)), Z((n, p)), Z((n, q)), Z((n, l))],
+        [Z((n, n)), SA.T, Z((n, n)), -S, Z((n, p)), Z((n, q)), L.T],
+        [(X @ B).T, (S @ B).T, Z((p, n)), Z((p, n)), -gamma2 * I(p), Z((p, q)), Z((p, l))],
+        [Z((q, n)), BD.T, Z((q, n)), Z((q, n)), Z((q, p)), -gamma2 * I(q), Z((q, l))],
+        [Z((l, n)), Z((l, n)), Z((l, n)), L, Z((l, p)), Z((l, q)), -I(l)],
+    ]
+    if H is not None:
+        r = H.shape[1]
+        rows[2][2] = -X + lam * (E.T @ E)
+        extra = [X @ H, S @ H] + [Z((k, r)) for k in (n, n, p, q, l)]
+        for row, blk in zip(rows, extra):
+            row.append(blk)
+        rows.append([(X @ H).T, (S @ H).T, Z((r, n)), Z((r, n)), Z((r, p)), Z((r, q)), Z((r, l)), -lam * I(r)])
+    return bmat(rows)
+
+
 def _gamma_index(n, p, q):
     return np.arange(4 * n, 4 * n + p + q)
 
@@ -186,6 +266,7 @@ class _Prepared:
     sigma: np.ndarray  # x = diag(sigma) x~
     H_balanced: np.ndarray  # balanced factors in the original state coordinates
     E_balanced: np.ndarray
+    form: str = "general"  # "observer": Ā_F = S A + B̄_F C and C̄_F = −L (scaled data) are substituted
 
 
 def prepare_uncertainty(H, E, structure="diagonal", tol=0.0):
@@ -266,7 +347,7 @@ def _state_scaling(A, mode):
     return np.array([_pow2(v) for v in sca])
 
 
-def _prepare(system, structure, state_scaling):
+def _prepare(system, structure, state_scaling, form="general"):
     H_b = E_b = None
     if system.H is not None:
         H_b, E_b, _ = prepare_uncertainty(system.H, system.E, structure)
@@ -280,7 +361,7 @@ def _prepare(system, structure, state_scaling):
     if H_b is not None:
         H = Si[:, None] * H_b
         E = E_b * sigma[None, :]
-    return _Prepared(A, B, C, system.D, L, H, E, sigma, H_b, E_b)
+    return _Prepared(A, B, C, system.D, L, H, E, sigma, H_b, E_b, form)
 
 
 # ----------------------------------------------------------------------------
@@ -341,6 +422,9 @@ class SynthesisResult:
     deltas : ndarray or None
         The δ of each sample (same order as ``sample_norms``), for
         :func:`design_for_scenario`.
+    form : str
+        ``"general"`` (LMI (20) as in the paper) or ``"observer"`` (filter
+        constrained to ``C_F = −L``, ``A_F = A + B_F C``; see :func:`synthesize`).
     """
 
     A_F: np.ndarray
@@ -363,6 +447,7 @@ class SynthesisResult:
     samples: tuple = ()
     delta_bar: float = None
     deltas: np.ndarray = None
+    form: str = "general"
 
     def statespace(self):
         """The filter as a discrete :class:`control.StateSpace` (y → z_f), with ``dt``."""
@@ -515,16 +600,25 @@ def _solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
     ``gamma2="free"``: the same for the γ-free part of (20) (its rows and
     columns without −γ²I); it is feasible iff (20) is for some finite γ.
     The solution's ``gamma2`` is then NaN (the certificate finds γ).
+
+    With ``P.form == "observer"`` the equality constraints
+    ``Ā_F = S A + B̄_F C`` and ``C̄_F = −L`` (in the scaled coordinates of
+    ``P``) are eliminated by substitution, and the LMI is posed in its
+    congruent form :func:`observer_lmi_matrix` (variables X = R − S, S,
+    B̄_F, λ), on which the solvers converge (on (20) with the substitution
+    they stop with numerical errors near the optimum).
     """
     n, p = P.B.shape
     m = P.C.shape[0]
     q = P.D.shape[1]
     l = P.L.shape[0]
-    R = cp.Variable((n, n), symmetric=True)
+    observer = P.form == "observer"
+    # (variables created in the same order as before the observer option: identical general-form problems)
+    X = cp.Variable((n, n), symmetric=True)  # R in the general form, R − S in the observer form
     S = cp.Variable((n, n), symmetric=True)
-    AbF = cp.Variable((n, n))
+    AbF = None if observer else cp.Variable((n, n))
     BbF = cp.Variable((n, m))
-    CbF = cp.Variable((l, n))
+    CbF = None if observer else cp.Variable((l, n))
     lam = cp.Variable() if P.H is not None else 0.0
     if gamma2 is None:
         g = cp.Variable()
@@ -532,7 +626,12 @@ def _solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
         g = 0.0
     else:
         g = float(gamma2)
-    M = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, R, S, AbF, BbF, CbF, lam, g, bmat=cp.bmat)
+    if observer:
+        R = X + S
+        M = observer_lmi_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, X, S, BbF, lam, g, bmat=cp.bmat)
+    else:
+        R = X
+        M = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, R, S, AbF, BbF, CbF, lam, g, bmat=cp.bmat)
     if isinstance(gamma2, str):
         keep = np.setdiff1d(np.arange(M.shape[0]), _gamma_index(n, p, q))
         M = M[keep, :][:, keep]
@@ -564,8 +663,16 @@ def _solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
             return _Solution(f"solver error ({error})", float("nan"), seconds=time.perf_counter() - start)
     seconds = time.perf_counter() - start
     status = str(prob.status)
-    if R.value is None or S.value is None:
+    if X.value is None or S.value is None:
         return _Solution(status, float("nan"), seconds=seconds)
+    sym = lambda Y: 0.5 * (Y + Y.T)  # noqa: E731
+    S_val = sym(S.value)
+    if observer:
+        R_val = S_val + sym(X.value)
+        Abar, Cbar = S_val @ P.A + BbF.value @ P.C, -P.L.copy()
+    else:
+        R_val = sym(X.value)
+        Abar, Cbar = AbF.value.copy(), CbF.value.copy()
     if gamma2 is None:
         gval = float(g.value)
     elif isinstance(gamma2, str):
@@ -573,15 +680,14 @@ def _solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
     else:
         gval = float(gamma2)
     tval = margin if gamma2 is None else float(t.value)
-    sym = lambda X: 0.5 * (X + X.T)  # noqa: E731
     return _Solution(
         status,
         gval,
-        sym(R.value),
-        sym(S.value),
-        AbF.value.copy(),
+        R_val,
+        S_val,
+        Abar,
         BbF.value.copy(),
-        CbF.value.copy(),
+        Cbar,
         float(lam.value) if P.H is not None else 0.0,
         tval,
         seconds,
@@ -606,10 +712,21 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
     condS = np.linalg.cond(sol.S)
     if not np.isfinite(condS) or condS > 1e14:
         return _Check(False, f"S is singular to working precision (cond {condS:.3g}); (21) cannot be applied")
+    sig = P.sigma
     # (21) in scaled coordinates
-    AFs = np.linalg.solve(sol.S, sol.Abar_F)
     BFs = np.linalg.solve(sol.S, sol.Bbar_F)
-    CFs = sol.Cbar_F
+    if P.form == "observer":
+        # the structure is imposed on the returned filter itself, in the original coordinates
+        # (S⁻¹(S Ã + B̄_F C̃) equals Ã + B̃_F C̃ only to round-off): B_F = Σ B̃_F, C_F = −L,
+        # A_F = A + B_F C; the certificate below is evaluated at exactly this filter, scaled back
+        # by powers of two (exact): Ã_F = Σ⁻¹ A_F Σ, C̃_F = C_F Σ = −L̃
+        B_F_obs = sig[:, None] * BFs
+        A_F_obs = system.A + B_F_obs @ system.C
+        AFs = A_F_obs * sig[None, :] / sig[:, None]
+        CFs = -P.L
+    else:
+        AFs = np.linalg.solve(sol.S, sol.Abar_F)
+        CFs = sol.Cbar_F
     if not (np.all(np.isfinite(AFs)) and np.all(np.isfinite(BFs)) and np.all(np.isfinite(CFs))):
         return _Check(False, "the rebuilt filter has non-finite entries")
     # certificate: (20) at the returned filter (Abar_F = S A_F, Bbar_F = S B_F)
@@ -617,10 +734,12 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
     p, q = P.B.shape[1], P.D.shape[1]
     gamma_c, info = schur_gamma(M0, _gamma_index(n, p, q))
     # undo the state scaling exactly (powers of two): x_f = Σ x̃_f
-    sig = P.sigma
-    A_F = sig[:, None] * AFs / sig[None, :]
-    B_F = sig[:, None] * BFs
-    C_F = CFs / sig[None, :]
+    if P.form == "observer":
+        A_F, B_F, C_F = A_F_obs, B_F_obs, -system.L
+    else:
+        A_F = sig[:, None] * AFs / sig[None, :]
+        B_F = sig[:, None] * BFs
+        C_F = CFs / sig[None, :]
     Si = 1.0 / sig
     variables = {
         "R": Si[:, None] * sol.R * Si[None, :],
@@ -688,6 +807,7 @@ def synthesize(
     state_scaling="balance",
     max_bisection=40,
     polish=True,
+    form="general",
     _labels=None,
     _deltas=None,
     _delta_bar=None,
@@ -748,6 +868,11 @@ def synthesize(
         Clarabel solution and keep the smaller certified γ (Clarabel stops
         about 1e-5 short of the optimum on the paper's model, CVXOPT about
         1e-8). ``False``: stop at the first certified solution.
+    form : {"general", "observer"}, optional
+        ``"general"`` (default): LMI (20) as in the paper, any full-order
+        filter (12). ``"observer"``: the filter is constrained to a
+        predictor observer, ``C_F = −L`` and ``A_F = A + B_F C`` (see Notes);
+        needs ``L`` square and invertible.
 
     Returns
     -------
@@ -756,7 +881,8 @@ def synthesize(
     Raises
     ------
     InputError
-        Mismatched shapes, non-finite entries, bad options.
+        Mismatched shapes, non-finite entries, bad options (an unknown
+        ``form``, or ``form="observer"`` with ``L`` not square and invertible).
     UnstablePlantError
         ``A + H F E`` is not Schur stable at some sample (no finite γ).
     InfeasibleLMIError
@@ -770,6 +896,43 @@ def synthesize(
     (13)–(15); its norm bound (16) holds for all F with ``FᵀF ≤ I``. The
     LMI is the paper's, with a single multiplier λ (Lemma 2): for diagonal F
     it is conservative.
+
+    **Observer form.** With ``C_F = −L`` and, for ``L = I``, ``x̂ = −x_f``,
+    the predictor observer ``x̂⁺ = A x̂ + G (y − C x̂)`` reads
+    ``x_f⁺ = (A − G C) x_f − G y``: it is the filter (12) with
+    ``B_F = −G`` and ``A_F = A + B_F C``. By (21), ``A_F = S⁻¹Ā_F`` and
+    ``B_F = S⁻¹B̄_F``, so multiplying by S turns these into constraints that
+    are *linear* in the LMI variables::
+
+        C̄_F = −L,      Ā_F = S A + B̄_F C.
+
+    They are added to (20) by substitution (Ā_F and C̄_F are no longer free
+    variables), so Corollary 1 with them is still an SDP and its optimum
+    γ_observer ≥ γ* (a restriction). The estimation error
+    ``e = x − x̂ = x + x_f`` then obeys
+
+        e⁺ = (A − G C) e + ΔA x + B w − G D v,
+
+    which does not involve the plant trajectory at ΔA = 0: an initial
+    state, or a thrust the filter is told exactly, does not leak into the
+    error (the general optimum's error depends on x). For an invertible
+    ``L ≠ I`` the same filter estimates ``z = L x`` by ``z_f = L x̂`` (its
+    error is ``L e``); :func:`observer_form`, which compares
+    ``C_F A_F C_F⁻¹`` with A, reports a zero residual only for ``L = I``.
+
+    The state scaling ``x = Σ x̃`` of the numerics is applied to the
+    constraints as well (``C̄_F = −L Σ``, ``Ā_F = S Σ⁻¹AΣ + B̄_F C Σ``), and
+    the returned filter is rebuilt in the original coordinates as
+    ``B_F = Σ S⁻¹B̄_F``, ``A_F = A + B_F C``, ``C_F = −L``: the identities
+    hold to the round-off of one product and sum. The solvers get the
+    substituted LMI in a congruent form, :func:`observer_lmi_matrix` (in the
+    coordinates (x, e); on (20) itself they stall near the optimum).
+    Certification is unchanged: (20) by eigenvalues at exactly the returned
+    filter, and the sampled norms.
+
+    The derivation itself only uses ``C_F = −L`` (the filter state is
+    always a full state estimate); ``L`` is required square and invertible
+    so that ``x̂ = C_F x_f`` is that estimate, as in the paper (L = I).
     """
     t_start = time.perf_counter()
     system = UncertainSystem(A, B, C, D, L, H, E, dt=1.0)
@@ -781,6 +944,21 @@ def synthesize(
     rtol = as_positive("rtol", rtol)
     max_bisection = as_int_at_least("max_bisection", max_bisection, 1)
     n_random_samples = as_int_at_least("n_random_samples", n_random_samples, 0)
+    if not isinstance(form, str):
+        raise InputError(f"form must be a string, one of {', '.join(FORMS)}; got {form!r}")
+    form = as_choice("form", form, FORMS)
+    if form == "observer":
+        n_state, l_out = system.A.shape[0], system.L.shape[0]
+        if l_out != n_state:
+            raise InputError(
+                f"form='observer' needs the filter to estimate the whole state: L must be square and invertible, "
+                f"got L of shape {l_out}x{n_state}"
+            )
+        condL = np.linalg.cond(system.L)
+        if not condL < 1e12:
+            raise InputError(
+                f"form='observer' needs L square and invertible (C_F = −L); L is singular (cond {condL:.3g})"
+            )
     if solver is None:
         solvers = ["CLARABEL", "CVXOPT"]
     else:
@@ -796,7 +974,7 @@ def synthesize(
     checked_samples = samples if system.H is not None else [None]
     _check_plant(system, checked_samples, _labels)
 
-    P = _prepare(system, structure, state_scaling)
+    P = _prepare(system, structure, state_scaling, form)
     log = []
     statuses = []
     candidates = []
@@ -839,6 +1017,7 @@ def synthesize(
             samples=tuple(checked_samples),
             delta_bar=_delta_bar,
             deltas=None if _deltas is None else np.asarray(_deltas, dtype=float),
+            form=form,
         )
     if any(st in _INFEASIBLE or st.startswith("infeasible") for _, st in statuses):
         hint = (
@@ -847,6 +1026,11 @@ def synthesize(
             if structure == "full" and system.H is not None and min(system.H.shape[1], system.E.shape[0]) > 1
             else ""
         )
+        if form == "observer":
+            hint += (
+                " The observer-form constraints (C_F = −L, A_F = A + B_F C) were imposed; "
+                "form='general' may be feasible."
+            )
         raise InfeasibleLMIError(
             "LMI (20) is infeasible: no R, S, λ make the error system quadratically stable for every admissible F, "
             "so Theorem 1 gives no filter for any γ (solver status: "
@@ -974,7 +1158,7 @@ def design_for_scenario(scenario=None, delta_bar=None, *, delta_points=21, **opt
     delta_points : int, optional
         Points of the δ grid.
     **options
-        Passed to :func:`synthesize` (``solver``, ``method``, ...).
+        Passed to :func:`synthesize` (``solver``, ``method``, ``form``, ...).
 
     Returns
     -------
@@ -1076,7 +1260,8 @@ def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **
     progress : bool, optional
         Show a tqdm progress bar.
     **options
-        Passed to :func:`design_for_scenario`.
+        Passed to :func:`design_for_scenario` (``form="observer"`` for the
+        observer-form curve).
 
     Returns
     -------
@@ -1091,7 +1276,7 @@ def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **
     return GammaSweep(dbs, tuple(results))
 
 
-def design_report(delta_bar, solver=None, scenario=None):
+def design_report(delta_bar, solver=None, scenario=None, form="general"):
     """JSON-ready summary of one certified design (for ``python -m hinfnav design``).
 
     Parameters
@@ -1101,18 +1286,21 @@ def design_report(delta_bar, solver=None, scenario=None):
     solver : str, optional
         ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: Clarabel, CVXOPT fallback).
     scenario : Scenario, optional
+    form : {"general", "observer"}, optional
+        Filter structure (see :func:`synthesize`).
 
     Returns
     -------
     dict
-        ``delta_bar``, ``gamma`` (certified), ``lmi_gamma``, ``verified_norm``,
-        ``worst_delta``, ``spectral_radius``, ``solver``, ``method``,
-        ``solve_time_s``, ``total_time_s``, ``dt``, ``A_F``, ``B_F``, ``C_F``
-        (nested lists), ``deltas_checked``, ``attempts``.
+        ``delta_bar``, ``form``, ``gamma`` (certified), ``lmi_gamma``,
+        ``verified_norm``, ``worst_delta``, ``spectral_radius``, ``solver``,
+        ``method``, ``solve_time_s``, ``total_time_s``, ``dt``, ``A_F``,
+        ``B_F``, ``C_F`` (nested lists), ``deltas_checked``, ``attempts``.
     """
-    res = design_for_scenario(scenario, delta_bar, solver=solver)
+    res = design_for_scenario(scenario, delta_bar, solver=solver, form=form)
     return {
         "delta_bar": float(res.delta_bar),
+        "form": res.form,
         "gamma": res.gamma,
         "lmi_gamma": res.lmi_gamma,
         "verified_norm": res.verified_norm,
@@ -1147,8 +1335,14 @@ def format_design_report(report):
     -------
     str
     """
+    form = report.get("form", "general")
+    form_text = {
+        "general": "general (LMI (20) as in the paper)",
+        "observer": "observer (C_F = −L, A_F = A + B_F C imposed on LMI (20))",
+    }.get(form, str(form))
     lines = [
         f"Robust H∞ filter, Corollary 1 of Sun et al. (2011), δ̄ = {report['delta_bar']:g}",
+        f"  filter form        : {form_text}",
         f"  certified γ        : {report['gamma']:.8g}   (LMI (20) verified by eigenvalues at the returned filter)",
         f"  solver γ           : {report['lmi_gamma']:.8g}   ({report['solver']}, {report['method']})",
         f"  worst sampled norm : {report['verified_norm']:.8g}   at δ = {report['worst_delta']:.6g} "
@@ -1297,43 +1491,89 @@ def compare_with_published(scenario=None, solver=None, delta_points=21, design=N
     }
 
 
-def simulation_comparison(design=None, scenario=None, runs=20, seed=0):
-    """Monte Carlo RMS errors of the published and the re-synthesized filter.
+def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest")):
+    """Monte Carlo RMS errors of the published and the re-synthesized filters.
 
-    Both filters run on the same simulated truths (:func:`hinfnav.simulation.simulate_truth`),
+    The filters run on the same simulated truths (:func:`hinfnav.simulation.simulate_truth`),
     with and without maneuver, from the paper's initial state and from rest
     (x₀ = 0, x̂₀ = 0, where only the noise excites the error, the setting of
     the H∞ bound). With maneuver the filters run exactly as (12); without
     maneuver they are told the applied thrust u = 0
     (:func:`hinfnav.filters.lti_from_matrices`), since (12) assumes u = Kx.
+    That correction is exact only for a filter in observer form.
 
     Parameters
     ----------
     design : SynthesisResult, optional
-        Default: :func:`design_for_scenario` at δ̄ = 0.05.
+        The general (LMI (20)) design; default :func:`design_for_scenario`
+        at δ̄ = 0.05.
     scenario : Scenario, optional
     runs : int, optional
         Monte Carlo runs per case.
     seed : int, optional
+    observer : SynthesisResult or bool, optional
+        A third filter, in observer form (:func:`synthesize` with
+        ``form="observer"``): a result to reuse, or True to design it at
+        the δ̄ of ``design`` (0.05 if unset). None or False: two filters.
+    starts : sequence of {"paper", "rest"}, optional
+        Initial conditions to simulate.
 
     Returns
     -------
     list of dict
-        One row per (start, maneuver, filter): ``start`` ("paper" or "rest"),
-        ``maneuver``, ``filter``, ``pos_rms`` (3,) m, ``vel_rms`` (3,) m/s, over
-        the scenario's RMS window (default 100–1000 s).
+        One row per (start, maneuver, filter): ``start``, ``maneuver``,
+        ``filter`` (``"published"``, ``"re-synthesized"``, ``"observer form"``),
+        ``pos_rms`` (3,) m, ``vel_rms`` (3,) m/s over the scenario's RMS
+        window (default 100–1000 s); and the filter's noise-only stationary
+        standard deviations ``stationary_pos_std`` (3,) m and
+        ``stationary_vel_std`` (3,) m/s (Euler truth, δ = 0, the design
+        model), which a filter whose error does not depend on the trajectory
+        approaches from any start once its initial error has decayed:
+
+        * with maneuver, (12) run verbatim on the closed loop,
+          :func:`hinfnav.kalman.lti_error_covariance`;
+        * without maneuver, for a filter exactly in observer form
+          (:func:`observer_form` residual ≤ 1e-9·max|A|) told the thrust,
+          whose error obeys ``e⁺ = (I + T A₁ − G C) e + B w − G D v`` (the
+          correction removes the ``−T G₀ K`` of the closed loop, so the error
+          decays without the controller's damping); NaN for the other
+          filters, whose error depends on the drifting plant state and has no
+          stationary covariance.
     """
     from .filters import lti_from_matrices
+    from .kalman import lti_error_covariance
     from .metrics import rms_error
     from .scenario import Scenario, published_filter
     from .simulation import run_estimator, simulate_truth
 
     scenario = Scenario() if scenario is None else scenario
     design = design_for_scenario(scenario, 0.05) if design is None else design
+    starts = [as_choice("start", st, ("paper", "rest")) for st in starts]
     pub = published_filter()
     filters = {"published": (pub.A_F, pub.B_F, pub.C_F), "re-synthesized": (design.A_F, design.B_F, design.C_F)}
+    if observer is True:
+        db = 0.05 if design.delta_bar is None else design.delta_bar
+        observer = design_for_scenario(scenario, db, form="observer")
+    if observer is not None and observer is not False:
+        filters["observer form"] = (observer.A_F, observer.B_F, observer.C_F)
+    design_A = scenario.design_model(0.0).A
+    C = scenario.design_model(0.0).C
+    open_loop = design_A - scenario.input_matrix_design() @ scenario.K  # I + T A₁ (Euler, u = 0)
+    stationary = {}
+    for name, (A_F, B_F, C_F) in filters.items():
+        std = np.sqrt(np.diag(lti_error_covariance(A_F, B_F, C_F, scenario, discretization="euler")))
+        stationary[name, True] = (std[:3], std[3:])
+        std = np.full(6, np.nan)
+        obs = observer_form(A_F, B_F, C_F, design_A, C)
+        if obs["residual"] <= 1e-9 * np.max(np.abs(design_A)):
+            G = obs["G"]
+            Ae = open_loop - G @ C
+            if spectral_radius(Ae) < 1:
+                Q = scenario.B @ scenario.B.T + G @ scenario.D @ scenario.D.T @ G.T
+                std = np.sqrt(np.diag(scipy.linalg.solve_discrete_lyapunov(Ae, Q)))
+        stationary[name, False] = (std[:3], std[3:])
     rows = []
-    for start in ("paper", "rest"):
+    for start in starts:
         sc = scenario if start == "paper" else scenario.replace(x0=np.zeros(6), xhat0=np.zeros(6))
         for maneuver in (True, False):
             truth = simulate_truth(sc, maneuver=maneuver, runs=runs, seed=seed)
@@ -1341,5 +1581,15 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0):
                 est = lti_from_matrices(A_F, B_F, C_F, sc, name=name, uses_input=not maneuver)
                 res = run_estimator(est, truth, sc.xhat0)
                 pos, vel = rms_error(res.error, res.t, sc.rms_window_s)
-                rows.append({"start": start, "maneuver": maneuver, "filter": name, "pos_rms": pos, "vel_rms": vel})
+                rows.append(
+                    {
+                        "start": start,
+                        "maneuver": maneuver,
+                        "filter": name,
+                        "pos_rms": pos,
+                        "vel_rms": vel,
+                        "stationary_pos_std": stationary[name, maneuver][0],
+                        "stationary_vel_std": stationary[name, maneuver][1],
+                    }
+                )
     return rows
