@@ -188,3 +188,14 @@ def test_lti_filter_bad_input():
         f.estimate(np.ones((1, 5, 3)), np.ones((1, 5, 3)), np.zeros(3))
     with pytest.raises(InputError, match="y must contain only finite"):
         f.estimate(np.full((1, 5, 3), np.nan), np.ones((1, 5, 3)), np.zeros(6))
+
+
+def test_shared_covariance_stays_a_view_across_batches():
+    # the EKF's covariance with the linear measurement does not depend on the data; joined
+    # over batches it must stay one shared array (stride 0), equal to the single-batch result
+    s = short()
+    a = simulate(s, "ekf", runs=5, seed=3, batch_size=2)
+    b = simulate(s, "ekf", runs=5, seed=3, batch_size=5)
+    assert a.P.shape == (5, s.n_steps + 1, 6, 6) and a.P.strides[0] == 0
+    np.testing.assert_allclose(a.P[4], b.P[4], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(a.xhat, b.xhat, rtol=1e-12, atol=1e-9)
