@@ -39,6 +39,7 @@ from .validation import as_int_at_least
 __all__ = [
     "PAPER_TABLE1",
     "CITATION",
+    "axes_rms",
     "Table1",
     "table1",
     "table1_rows",
@@ -82,7 +83,8 @@ TABLE_FILTERS = {
 CASES = {"no_maneuver": False, "maneuver": True}
 
 
-def _axes_rms(values):
+def axes_rms(values):
+    """One number from per-axis values: ``sqrt(mean(v²))`` over x, y, z (how a Table 1 cell is formed)."""
     return float(np.sqrt(np.mean(np.square(values))))
 
 
@@ -221,7 +223,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
 def _kl_axes(kl, predicted=False):
     """(pos_m, vel_mps) scalars (RMS over axes) of a kalman_limit record (filtered or predicted)."""
     suffix = "_predicted" if predicted else ""
-    return _axes_rms(kl["pos_m" + suffix]), _axes_rms(kl["vel_mps" + suffix])
+    return axes_rms(kl["pos_m" + suffix]), axes_rms(kl["vel_mps" + suffix])
 
 
 def table1_rows(tab):
@@ -406,7 +408,7 @@ def robustness_table(scenario=None, *, deltas=(0.0, 1.0), noises=("gaussian", "c
         per = rms_per_run(res.error, res.t, scenario.rms_window_s)
         pooled = np.sqrt(np.mean(per**2, axis=0))
         rows.append({"filter": f, "delta": float(d), "noise": n, "runs": runs,
-                     "pos_m": _axes_rms(pooled[:3]), "vel_mps": _axes_rms(pooled[3:])})
+                     "pos_m": axes_rms(pooled[:3]), "vel_mps": axes_rms(pooled[3:])})
     return rows
 
 
