@@ -37,6 +37,7 @@ import numpy as np
 import scipy.linalg
 
 from .exceptions import HinfnavError, InputError, UnstablePlantError
+from .hinfnorm import error_system_matrices
 from .models import measurement_matrix, spectral_radius
 from .scenario import Scenario
 from .validation import as_choice, as_matrix, as_real
@@ -285,7 +286,7 @@ def lti_error_covariance(
             "its state, and the error of a filter without exact observer form, has no stationary covariance"
         )
     A_eff = A_F.copy()
-    M_u = np.zeros((6, 6))
+    M_u_gain = np.zeros((6, 3))
     if (input_matrix is None) != (K is None):
         raise InputError("input_matrix and K must be given together to use the known thrust")
     if input_matrix is not None:
@@ -293,14 +294,17 @@ def lti_error_covariance(
         K_F = as_matrix("K", K, (3, 6))
         M = np.linalg.solve(C_F, G)
         A_eff = A_F - M @ K_F @ C_F
-        M_u = M @ K_truth
+        M_u_gain = M
     rho_f = spectral_radius(A_eff)
     if rho_f >= 1:
         raise InputError(f"A_F (with the input correction, if any) must be Schur stable; spectral radius {rho_f:.6f}")
     C, B, D = measurement_matrix(), scenario.B, scenario.D
-    Aa = np.block([[A_t, np.zeros((6, 6))], [B_F @ C + M_u, A_eff]])
-    Ba = np.block([[B, np.zeros((6, D.shape[1]))], [np.zeros((6, B.shape[1])), B_F @ D]])
+    # The error system (13)-(14); the known thrust u = K_truth x enters the filter like an
+    # extra measurement channel: B_F C + M K_truth = [B_F, M] [C; K_truth], noise [D; 0].
+    Aa, Ba, Ca = error_system_matrices(
+        A_t, B, np.vstack([C, K_truth]), np.vstack([D, np.zeros((3, D.shape[1]))]), np.eye(6),
+        A_eff, np.hstack([B_F, M_u_gain]), C_F,
+    )
     Sigma = scipy.linalg.solve_discrete_lyapunov(Aa, Ba @ Ba.T)
-    T = np.hstack([np.eye(6), -C_F])
-    cov = T @ Sigma @ T.T
+    cov = Ca @ Sigma @ Ca.T
     return 0.5 * (cov + cov.T)
