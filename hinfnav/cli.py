@@ -1,6 +1,8 @@
 """Command line: ``python -m hinfnav {simulate,design,reproduce} ...``.
 
-Run ``python -m hinfnav COMMAND --help`` for each command's options.
+Run ``python -m hinfnav COMMAND --help`` for each command's options. The
+commands import the heavy layers (cvxpy, python-control, matplotlib) only
+when they run.
 """
 
 import argparse
@@ -10,7 +12,7 @@ import sys
 
 import numpy as np
 
-from .exceptions import HinfnavError
+from .core.exceptions import HinfnavError
 
 __all__ = ["main", "simulate_report", "format_simulate_report"]
 
@@ -27,20 +29,21 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         (x, y, z), ``max_pos_m``, ``max_vel_mps``, and over runs
         ``mc_mean_pos_m`` etc. (per-run RMS averaged, with a 95 % interval).
     """
-    from .filters import make_estimator
     from .metrics import max_error, monte_carlo_summary, rms_error
-    from .scenario import Scenario
-    from .simulation import simulate
+    from .papers.sun2011 import Scenario, make_estimator
+    from .sim import simulate
 
     scenario = Scenario() if scenario is None else scenario
     est = make_estimator(filter, scenario)
     res = simulate(scenario, est, maneuver=maneuver, delta=delta, noise=noise, runs=runs, seed=seed,
                    discretization=discretization, progress=progress)
     win = scenario.rms_window_s
-    pos, vel = rms_error(res.error, res.t, win)
+    st = res.state
+    pos, vel = (st.select(rms_error(res.error, res.t, win), g) for g in ("position", "velocity"))
     mx = max_error(res.error, res.t, win)
     mc = monte_carlo_summary(res.error, res.t, win)
     r = lambda a: [float(v) for v in np.asarray(a)]  # noqa: E731
+    P, V = st.indices("position"), st.indices("velocity")
     return {
         "filter": filter,
         "maneuver": bool(maneuver),
@@ -54,12 +57,12 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         "window_s": list(win),
         "rms_pos_m": r(pos),
         "rms_vel_mps": r(vel),
-        "max_pos_m": r(mx[:3]),
-        "max_vel_mps": r(mx[3:]),
-        "mc_mean_pos_m": r(mc.mean[:3]),
-        "mc_mean_vel_mps": r(mc.mean[3:]),
-        "mc_ci95_pos_m": [r(mc.ci95[0, :3]), r(mc.ci95[1, :3])],
-        "mc_ci95_vel_mps": [r(mc.ci95[0, 3:]), r(mc.ci95[1, 3:])],
+        "max_pos_m": r(mx[list(P)]),
+        "max_vel_mps": r(mx[list(V)]),
+        "mc_mean_pos_m": r(mc.mean[list(P)]),
+        "mc_mean_vel_mps": r(mc.mean[list(V)]),
+        "mc_ci95_pos_m": [r(mc.ci95[0, list(P)]), r(mc.ci95[1, list(P)])],
+        "mc_ci95_vel_mps": [r(mc.ci95[0, list(V)]), r(mc.ci95[1, list(V)])],
         "error_measure": "per-axis RMS of x - xhat over window_s, pooled over runs",
     }
 
@@ -87,22 +90,23 @@ def _cmd_simulate(args):
 
 
 def _cmd_design(args):
-    from .synthesis import design_report, format_design_report
+    from .papers.sun2011.designs import design_report, format_design_report
 
     rep = design_report(args.delta_bar, solver=args.solver, form=args.form)
     print(json.dumps(rep, indent=2) if args.json else format_design_report(rep))
 
 
 def _cmd_reproduce(args):
-    from .reproduction import reproduce
+    from .papers import reproduce
 
-    reproduce(args.out, seed=args.seed, runs=args.runs, notebooks=args.notebooks, progress=True)
+    reproduce(args.paper, args.out, seed=args.seed, runs=args.runs, notebooks=args.notebooks, progress=True)
 
 
 def _parser():
-    from .filters import FILTER_NAMES
+    from .lmi.solve import SOLVERS
     from .noise import NOISE_NAMES
-    from .synthesis import SOLVERS
+    from .papers import PAPERS
+    from .papers.sun2011.filters import FILTER_NAMES
 
     p = argparse.ArgumentParser(
         prog="python -m hinfnav",
@@ -132,7 +136,9 @@ def _parser():
     d.add_argument("--json", action="store_true", help="print one JSON object")
     d.set_defaults(func=_cmd_design)
 
-    r = sub.add_parser("reproduce", help="regenerate Table 1 and Figs 2-7 into a folder")
+    r = sub.add_parser("reproduce", help="regenerate a paper's tables and figures into a folder (Table 1, Figs 2-7)")
+    r.add_argument("--paper", default="all", choices=("all",) + tuple(PAPERS),
+                   help="which paper (default: all; sun2011 writes into --out itself)")
     r.add_argument("--out", default="results", help="output folder (default: results/)")
     r.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     r.add_argument("--runs", type=int, default=100, help="Monte Carlo runs per case (default 100)")

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .exceptions import InputError
-from .validation import as_choice, as_int_at_least, as_positive
+from .core.exceptions import InputError
+from .core.validation import as_choice, as_int_at_least, as_positive
 
 __all__ = [
     "NoiseModel",

@@ -1,21 +1,17 @@
-"""Error metrics of simulated navigation runs.
+"""Error metrics of simulated estimation runs, for any state dimension.
 
-The paper's Table 1 gives one position and one velocity number per filter.
-This workbook takes them to be the **per-axis RMS of the estimation error
-over the steady part of the run** (see ``notebooks/01_model_and_scenario``
-for the evidence: the published filter's steady-state per-axis error standard
-deviation, from a Lyapunov equation, is 0.18 m and 0.80 m/s, which the paper
-rounds to 0.2 and 0.8; the norm of the error vector would be 0.31 m and
-1.39 m/s). :func:`rms_error` therefore reports three numbers (x, y, z) for
-position and three for velocity; the scalar in a table is their maximum.
+Every function works on error histories of shape (runs, n_samples, n) (or
+(n_samples, n) for one run) and returns one number per state component; the
+state's groups (``"position"``, ``"velocity"`` …, from its
+:class:`~hinfnav.systems.StateSpec`) select components by name
+(:func:`by_group`, :func:`group_rms`), so no metric slices ``[:3]``.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from .exceptions import InputError
-from .validation import as_positive
+from ..core.exceptions import InputError
 
 __all__ = [
     "window_mask",
@@ -25,6 +21,9 @@ __all__ = [
     "convergence_time",
     "MonteCarloSummary",
     "monte_carlo_summary",
+    "by_group",
+    "group_rms",
+    "axes_rms",
 ]
 
 
@@ -32,8 +31,8 @@ def _check_error(error, t):
     error = np.asarray(error, dtype=float)
     if error.ndim == 2:
         error = error[None]
-    if error.ndim != 3 or error.shape[2] != 6:
-        raise InputError(f"error must have shape (runs, n_steps + 1, 6) or (n_steps + 1, 6); got {np.shape(error)}")
+    if error.ndim != 3 or error.shape[2] < 1:
+        raise InputError(f"error must have shape (runs, n_samples, n) or (n_samples, n); got {np.shape(error)}")
     t = np.asarray(t, dtype=float)
     if t.shape != (error.shape[1],):
         raise InputError(f"t must have shape ({error.shape[1]},) to match error; got {t.shape}")
@@ -66,15 +65,15 @@ def rms_per_run(error, t, window):
 
     Parameters
     ----------
-    error : array_like, shape (runs, n_steps + 1, 6)
-    t : array_like, shape (n_steps + 1,)
+    error : array_like, shape (runs, n_samples, n)
+    t : array_like, shape (n_samples,)
     window : (float, float)
         Start and end time, s.
 
     Returns
     -------
-    ndarray, shape (runs, 6)
-        m for the first three columns, m/s for the last three.
+    ndarray, shape (runs, n)
+        In the units of each state component.
     """
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
@@ -82,39 +81,28 @@ def rms_per_run(error, t, window):
 
 
 def rms_error(error, t, window):
-    """Per-axis RMS error pooled over the runs and a time window.
-
-    Returns
-    -------
-    pos : ndarray, shape (3,)
-        x, y, z position RMS, m.
-    vel : ndarray, shape (3,)
-        x, y, z velocity RMS, m/s.
-    """
+    """RMS of each error component pooled over the runs and a time window, shape (n,)."""
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
-    rms = np.sqrt(np.mean(error[:, mask] ** 2, axis=(0, 1)))
-    return rms[:3], rms[3:]
+    return np.sqrt(np.mean(error[:, mask] ** 2, axis=(0, 1)))
 
 
 def max_error(error, t, window):
-    """Largest absolute error per component over runs and window, shape (6,)."""
+    """Largest absolute error per component over runs and window, shape (n,)."""
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
     return np.max(np.abs(error[:, mask]), axis=(0, 1))
 
 
-def convergence_time(error, t, pos_tol=1.0, vel_tol=2.0):
-    """Time after which every error component stays within a tolerance.
+def convergence_time(error, t, tol):
+    """Time after which every error component stays within its tolerance.
 
     Parameters
     ----------
-    error : array_like, shape (runs, n_steps + 1, 6)
-    t : array_like, shape (n_steps + 1,)
-    pos_tol : float
-        Tolerance on each position component, m.
-    vel_tol : float
-        Tolerance on each velocity component, m/s.
+    error : array_like, shape (runs, n_samples, n)
+    t : array_like, shape (n_samples,)
+    tol : array_like, shape (n,) or float
+        Tolerance of each component, in its units (> 0).
 
     Returns
     -------
@@ -123,7 +111,9 @@ def convergence_time(error, t, pos_tol=1.0, vel_tol=2.0):
         components; ``nan`` for a run that never settles.
     """
     error, t = _check_error(error, t)
-    tol = np.r_[np.full(3, as_positive("pos_tol", pos_tol)), np.full(3, as_positive("vel_tol", vel_tol))]
+    tol = np.broadcast_to(np.asarray(tol, dtype=float), (error.shape[2],))
+    if not np.all(np.isfinite(tol)) or np.any(tol <= 0):
+        raise InputError(f"tol must be finite and > 0 for every component; got {tol}")
     outside = np.any(np.abs(error) > tol, axis=2)  # (runs, n)
     out = np.full(error.shape[0], np.nan)
     n = t.size
@@ -143,14 +133,14 @@ class MonteCarloSummary:
     Attributes
     ----------
     runs : int
-    mean : ndarray, shape (6,)
-        Mean over runs of the per-run RMS error (m, m/s).
-    ci95 : ndarray, shape (2, 6)
+    mean : ndarray, shape (n,)
+        Mean over runs of the per-run RMS error (units of each component).
+    ci95 : ndarray, shape (2, n)
         95 % confidence interval of that mean (normal approximation,
         mean ± 1.96 s/√runs).
-    spread95 : ndarray, shape (2, 6)
+    spread95 : ndarray, shape (2, n)
         2.5 and 97.5 percentiles of the per-run RMS (what one run may give).
-    pooled : ndarray, shape (6,)
+    pooled : ndarray, shape (n,)
         RMS pooled over all runs and samples.
     """
 
@@ -166,7 +156,7 @@ def monte_carlo_summary(error, t, window):
     per_run = rms_per_run(error, t, window)
     runs = per_run.shape[0]
     mean = per_run.mean(axis=0)
-    sd = per_run.std(axis=0, ddof=1) if runs > 1 else np.zeros(6)
+    sd = per_run.std(axis=0, ddof=1) if runs > 1 else np.zeros(per_run.shape[1])
     half = 1.96 * sd / np.sqrt(runs)
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
@@ -178,3 +168,18 @@ def monte_carlo_summary(error, t, window):
         spread95=np.percentile(per_run, [2.5, 97.5], axis=0),
         pooled=pooled,
     )
+
+
+def by_group(values, state):
+    """Split per-component values (last axis = state) into the state's groups: ``{group: values}``."""
+    return {g: state.select(values, g) for g in state.groups}
+
+
+def group_rms(values, state, group):
+    """One number for a group: ``sqrt(mean(v²))`` over its components (how a table cell is formed)."""
+    return axes_rms(state.select(values, group))
+
+
+def axes_rms(values):
+    """One number from per-axis values: ``sqrt(mean(v²))`` over the last axis."""
+    return float(np.sqrt(np.mean(np.square(values))))

@@ -14,8 +14,8 @@ in the paper's scenario: Nyquist frequency π/T ≈ 31.4 rad/s).
 import numpy as np
 from matplotlib.colors import SymLogNorm
 
-from .exceptions import InputError
-from .hinfnorm import frequency_grid, frequency_response_sigma
+from ..core.exceptions import InputError
+from ..analysis.norms import frequency_grid, frequency_response_sigma
 
 __all__ = [
     "GAIN_LABEL",

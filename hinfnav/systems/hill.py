@@ -1,4 +1,4 @@
-"""Relative-motion models of the paper, Sections 1 and 4.
+"""Hill relative motion of a chaser about a target on a circular orbit (Sun et al. 2011, Sections 1 and 4).
 
 The state is ``x = [x, y, z, ẋ, ẏ, ż]`` (m, m/s) in the target's orbital frame
 (x radial, z along the orbit normal), the input is the chaser's thrust
@@ -19,32 +19,24 @@ Norm-bounded structure (10)–(11) of Section 4: ``ΔA₁ = H_a F(δ) E_a`` with
 ``F(δ)ᵀF(δ) ≤ I`` for ``|δ| ≤ δ̄``.
 """
 
-from dataclasses import dataclass
-
 import numpy as np
-import scipy.linalg
 
-from .exceptions import InputError
-from .validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real
+from ..core.exceptions import InputError
+from ..core.linalg import discretize
+from ..core.validation import as_nonnegative, as_positive, as_real
+from .linear import LinearSystem
+from .measurements import LinearMeasurement
+from .state import chaser_state_spec
 
 __all__ = [
-    "N_STATE",
-    "N_INPUT",
-    "N_MEAS",
     "hill_matrices",
     "delta_A1",
     "uncertainty_structure",
     "uncertainty_F",
-    "discretize",
     "measurement_matrix",
-    "spectral_radius",
-    "UncertainSystem",
+    "hill_system",
+    "position_measurement",
 ]
-
-N_STATE = 6
-N_INPUT = 3
-N_MEAS = 3
-
 
 def hill_matrices(omega, mass):
     """Continuous Hill model (2).
@@ -143,116 +135,46 @@ def uncertainty_F(delta, delta_bar):
     return np.diag([quad, 0.0, quad, delta / delta_bar, delta / delta_bar, 0.0])
 
 
-def discretize(Ac, Gc, dt, method="exact"):
-    """Discretize ``ẋ = Ac x + Gc u`` with a zero-order hold on ``u``.
-
-    Parameters
-    ----------
-    Ac : array_like, shape (n, n)
-    Gc : array_like, shape (n, m)
-    dt : float
-        Sampling time T, s.
-    method : {"exact", "euler"}
-        ``"euler"``: ``(I + T Ac, T Gc)``, the paper's (6).
-        ``"exact"``: ``(e^{Ac T}, ∫₀ᵀ e^{Ac s} ds Gc)``.
-
-    Returns
-    -------
-    Ad : ndarray, shape (n, n)
-    Gd : ndarray, shape (n, m)
-
-    Notes
-    -----
-    The two agree to first order in T; the Euler error is
-    ``T² Ac²/2 + O(T³)`` (tested in ``tests/test_models.py``).
-    """
-    Ac = as_matrix("Ac", Ac)
-    n = Ac.shape[0]
-    if Ac.shape != (n, n):
-        raise InputError(f"Ac must be square; got shape {Ac.shape}")
-    Gc = as_matrix("Gc", Gc, (n, None))
-    dt = as_positive("dt", dt)
-    as_choice("discretization method", method, ("exact", "euler"))
-    if method == "euler":
-        return np.eye(n) + dt * Ac, dt * Gc
-    m = Gc.shape[1]
-    M = np.zeros((n + m, n + m))
-    M[:n, :n] = Ac * dt
-    M[:n, n:] = Gc * dt
-    E = scipy.linalg.expm(M)
-    return E[:n, :n], E[:n, n:]
-
-
 def measurement_matrix():
     """The indirect position measurement ``C = [I₃ 0]`` of (8), shape (3, 6)."""
     return np.hstack([np.eye(3), np.zeros((3, 3))])
 
 
-def spectral_radius(A):
-    """Largest eigenvalue modulus of a square matrix."""
-    return float(np.max(np.abs(np.linalg.eigvals(np.asarray(A, dtype=float)))))
 
 
-@dataclass(frozen=True, eq=False)
-class UncertainSystem:
-    """The uncertain discrete system ψ_d of (9)–(11).
+def hill_system(omega, mass, dt, B, *, K=None, discretization="exact", name="Hill relative motion"):
+    """The Hill model (1)–(2) discretized with a zero-order hold, as a :class:`LinearSystem`.
 
-    ``x(k+1) = (A + H F E) x(k) + B w(k)``, ``y(k) = C x(k) + D v(k)``,
-    ``z(k) = L x(k)``, with ``FᵀF ≤ I``.
-
-    Attributes
+    Parameters
     ----------
-    A : ndarray, shape (n, n)
-    B : ndarray, shape (n, p)
-    C : ndarray, shape (m, n)
-    D : ndarray, shape (m, q)
-    L : ndarray, shape (l, n)
-    H : ndarray, shape (n, r) or None
-    E : ndarray, shape (r, n) or None
+    omega : float
+        Orbital rate of the target, rad/s.
+    mass : float
+        Chaser mass, kg.
     dt : float
         Sampling time, s.
+    B : array_like, shape (6, p)
+        Process-noise matrix (unit-variance w).
+    K : array_like, shape (3, 6), optional
+        State-feedback gain: with it the system is the closed loop
+        ``Φ + Γ K`` with no input (a filter that assumes the law u = K x).
+    discretization : {"exact", "euler"}
+
+    Returns
+    -------
+    LinearSystem
+        State (x, y, z, vx, vy, vz) in m and m/s; input thrust (Fx, Fy, Fz) in N.
     """
+    A0, G0 = hill_matrices(omega, mass)
+    Phi, Gamma = discretize(A0, G0, dt, discretization)
+    info = {"omega": float(omega), "mass": float(mass), "discretization": discretization}
+    if K is not None:
+        Phi = Phi + Gamma @ np.asarray(K, dtype=float)
+        Gamma = np.zeros((6, 0))
+        return LinearSystem(Phi, Gamma, B, dt, chaser_state_spec(), name=name + " (closed loop u = Kx)", info=info)
+    return LinearSystem(Phi, Gamma, B, dt, chaser_state_spec(), ("Fx", "Fy", "Fz"), ("N", "N", "N"), name=name, info=info)
 
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    D: np.ndarray
-    L: np.ndarray
-    H: np.ndarray = None
-    E: np.ndarray = None
-    dt: float = 1.0
 
-    def __post_init__(self):
-        A = as_matrix("A", self.A)
-        n = A.shape[0]
-        if A.shape != (n, n):
-            raise InputError(f"A must be square; got shape {A.shape}")
-        checked = {
-            "A": A,
-            "B": as_matrix("B", self.B, (n, None)),
-            "C": as_matrix("C", self.C, (None, n)),
-            "L": as_matrix("L", self.L, (None, n)),
-        }
-        checked["D"] = as_matrix("D", self.D, (checked["C"].shape[0], None))
-        if (self.H is None) != (self.E is None):
-            raise InputError("H and E must be given together (or both left out for a nominal system)")
-        if self.H is not None:
-            H = as_matrix("H", self.H, (n, None))
-            checked["H"] = H
-            checked["E"] = as_matrix("E", self.E, (H.shape[1], n))
-        for key, value in checked.items():
-            value.setflags(write=False)
-            object.__setattr__(self, key, value)
-        object.__setattr__(self, "dt", as_positive("dt", self.dt))
-
-    @property
-    def n(self):
-        """State dimension."""
-        return self.A.shape[0]
-
-    def perturbed_A(self, F):
-        """``A + H F E`` for a given uncertainty matrix ``F`` (shape (r, r))."""
-        if self.H is None:
-            return self.A.copy()
-        F = as_matrix("F", F, (self.H.shape[1], self.E.shape[0]))
-        return self.A + self.H @ F @ self.E
+def position_measurement(D):
+    """The indirect position measurement (8), ``y = [I 0] x + D v``, as a :class:`LinearMeasurement`."""
+    return LinearMeasurement(measurement_matrix(), D, ("x", "y", "z"), ("m", "m", "m"))

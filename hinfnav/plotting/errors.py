@@ -1,17 +1,16 @@
 """Plots of simulation results. Each function takes ``ax=`` (or ``axes=``)
 and returns the artists it drew; none touches global matplotlib state.
 
-The paper's figures show the position error (m) and the velocity error (m/s)
-per axis against time (s), and the thrust components (N).
+Error plots read the state's labels, units and groups from the result
+(:class:`~hinfnav.systems.StateSpec`): one row per group (position,
+velocity, …), one column per component.
 """
 
 import numpy as np
 
-from .exceptions import InputError
+from ..core.exceptions import InputError
 
-__all__ = ["new_figure", "plot_errors", "plot_error_axis", "plot_thrust", "plot_uncertainty_check"]
-
-_AXES = ("x", "y", "z")
+__all__ = ["new_figure", "plot_errors", "plot_error_axis", "plot_inputs", "plot_uncertainty_check"]
 
 
 def new_figure(nrows=1, ncols=1, *, figsize=None, **kwargs):
@@ -29,7 +28,7 @@ def _run(result, run):
     return result.error[run]
 
 
-def plot_error_axis(t, err, *, ax, quantity="position", axis_name="x", band=None, **line_kw):
+def plot_error_axis(t, err, *, ax, label="x", unit="m", band=None, **line_kw):
     """One error component against time.
 
     Parameters
@@ -37,10 +36,11 @@ def plot_error_axis(t, err, *, ax, quantity="position", axis_name="x", band=None
     t : ndarray, shape (n,)
         Time, s.
     err : ndarray, shape (n,)
-        Error, m or m/s.
+        Error, in ``unit``.
     ax : matplotlib.axes.Axes
-    quantity : {"position", "velocity"}
-    axis_name : str
+    label : str
+        Component name; the axis reads ``Δ<label> (<unit>)``.
+    unit : str
     band : float, optional
         Draw ±band as dashed lines (e.g. a steady-state standard deviation).
 
@@ -48,58 +48,71 @@ def plot_error_axis(t, err, *, ax, quantity="position", axis_name="x", band=None
     -------
     list of matplotlib artists
     """
-    unit = "m" if quantity == "position" else "m/s"
-    symbol = "Δ" + axis_name if quantity == "position" else "Δv" + axis_name
     artists = ax.plot(t, err, lw=0.6, **line_kw)
     if band is not None:
         artists += ax.plot([t[0], t[-1]], [band, band], "k--", lw=0.8)
         artists += ax.plot([t[0], t[-1]], [-band, -band], "k--", lw=0.8)
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel(f"{symbol} ({unit})")
+    ax.set_ylabel(f"Δ{label} ({unit})")
     ax.grid(True, alpha=0.3)
     return artists
 
 
-def plot_errors(result, *, axes, run=0, ylim_pos=None, ylim_vel=None, title=None, bands=None):
-    """Per-axis position and velocity errors of one run, the paper's layout.
+def plot_errors(result, *, axes, run=0, ylims=None, title=None, bands=None):
+    """Errors of one run, one row per state group and one column per component.
 
     Parameters
     ----------
     result : SimulationResult
-    axes : array of Axes, shape (2, 3) or (6,)
-        Row 0 position x, y, z; row 1 velocity x, y, z.
+        Carries ``state`` (labels, units, groups).
+    axes : array of Axes, shape (groups, components per group)
+        For the chaser: row 0 position x, y, z; row 1 velocity x, y, z.
     run : int
         Which Monte Carlo run to show.
-    ylim_pos, ylim_vel : (float, float), optional
-        y limits (the paper zooms in on the steady state).
+    ylims : dict, optional
+        Group name → (low, high) y limits.
     title : str, optional
         Put on the figure holding the axes.
-    bands : ndarray, shape (6,), optional
+    bands : ndarray, shape (n,), optional
         ±band lines per component (e.g. steady-state standard deviations).
 
     Returns
     -------
     list of matplotlib artists
     """
-    axes = np.asarray(axes).reshape(-1)
-    if axes.size != 6:
-        raise InputError(f"axes must hold 6 Axes (2 rows x 3 columns); got {axes.size}")
+    state = result.state
+    groups = list(state.groups.items())
+    axes = np.asarray(axes)
+    if axes.ndim != 2 or axes.shape[0] != len(groups) or any(len(idx) > axes.shape[1] for _, idx in groups):
+        raise InputError(
+            f"axes must be a grid with one row per state group ({len(groups)}: {', '.join(g for g, _ in groups)}) "
+            f"and a column per component; got shape {axes.shape}"
+        )
     err = _run(result, run)
     artists = []
-    for i in range(6):
-        quantity = "position" if i < 3 else "velocity"
-        band = None if bands is None else float(bands[i])
-        artists += plot_error_axis(result.t, err[:, i], ax=axes[i], quantity=quantity, axis_name=_AXES[i % 3], band=band)
-        lim = ylim_pos if i < 3 else ylim_vel
-        if lim is not None:
-            axes[i].set_ylim(*lim)
+    for row, (group, idx) in enumerate(groups):
+        for col, i in enumerate(idx):
+            band = None if bands is None else float(bands[i])
+            ax = axes[row, col]
+            artists += plot_error_axis(result.t, err[:, i], ax=ax, label=state.labels[i], unit=state.units[i], band=band)
+            if ylims and group in ylims:
+                ax.set_ylim(*ylims[group])
     if title:
-        artists.append(axes[0].figure.suptitle(title))
+        artists.append(axes[0, 0].figure.suptitle(title))
     return artists
 
 
-def plot_thrust(result, *, ax, run=0):
-    """Thrust components u = K x of one run against time (the paper's Fig 6).
+def plot_inputs(result, *, ax, run=0, labels=None, unit=""):
+    """Input components of one run against time.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    ax : matplotlib.axes.Axes
+    run : int
+    labels : sequence of str, optional
+        One per input channel (default ``u_0``, ``u_1`` …).
+    unit : str
 
     Returns
     -------
@@ -107,11 +120,13 @@ def plot_thrust(result, *, ax, run=0):
     """
     if not 0 <= run < result.u.shape[0]:
         raise InputError(f"run must be in 0 .. {result.u.shape[0] - 1}; got {run}")
+    m = result.u.shape[2]
+    labels = labels or [f"u_{i}" for i in range(m)]
     artists = []
-    for i, name in enumerate(("F_x", "F_y", "F_z")):
+    for i, name in enumerate(labels):
         artists += ax.plot(result.t, result.u[run, :, i], lw=1.0, label=f"${name}$")
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel("thrust (N)")
+    ax.set_ylabel(f"input ({unit})" if unit else "input")
     ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
     return artists

@@ -1,4 +1,4 @@
-"""Estimators by name, for the command line and the notebooks.
+"""Sun et al. (2011)'s estimators by name, registered for the command line, the notebooks and the contract tests.
 
 =========================  ===============================================
 name                       estimator
@@ -13,15 +13,20 @@ name                       estimator
 ``designed_observer``      the robust filter constrained to observer form
                            (``form="observer"``, an extension: its error does
                            not depend on the trajectory), told the thrust
-``ekf``                    the EKF of :mod:`hinfnav.ekf`, as the paper describes
+``ekf``                    the EKF of :mod:`hinfnav.papers.sun2011.ekf`, as the paper describes
                            it (does not know the control law)
 ``ekf_known_input``        the EKF told the applied thrust
 =========================  ===============================================
 """
 
-from .estimators import LTIFilter
-from .scenario import Scenario, published_filter
-from .validation import as_choice
+from ...core.exceptions import InputError
+from ...core.validation import as_choice
+from ...estimators.lti import LTIFilter
+from ...estimators.registry import register_estimator
+from .constants import published_filter
+from .designs import design_for_scenario
+from .ekf import build_ekf
+from .scenario import Scenario
 
 __all__ = ["FILTER_NAMES", "make_estimator", "lti_from_matrices"]
 
@@ -51,35 +56,59 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
     and without maneuver it has no guarantee at all: Lemma 1 needs the
     closed-loop plant it was designed on (see notebook 04).
     """
+    system, meas = scenario.system(), scenario.measurement
     if uses_input:
-        return LTIFilter(A_F, B_F, C_F, dt=scenario.dt, name=name, input_matrix=scenario.input_matrix_design(), K=scenario.K)
-    return LTIFilter(A_F, B_F, C_F, dt=scenario.dt, name=name)
+        return LTIFilter(A_F, B_F, C_F, system, meas, name=name, input_matrix=scenario.input_matrix_design(), K=scenario.K)
+    return LTIFilter(A_F, B_F, C_F, system, meas, name=name)
 
 
-def make_estimator(name, scenario=None, **options):
+def make_estimator(name, scenario, **options):
     """Build an estimator by name (see the module table).
 
     Parameters
     ----------
     name : str
-    scenario : Scenario, optional
-        Defaults to the paper's.
+    scenario : Scenario
     **options
         Passed to the estimator's builder (for ``designed``: options of
-        :func:`hinfnav.synthesize`; for the EKFs: see :mod:`hinfnav.ekf`).
+        :func:`hinfnav.synthesize`; for the EKFs: see :mod:`hinfnav.papers.sun2011.ekf`).
     """
-    scenario = Scenario() if scenario is None else scenario
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     as_choice("filter", name, FILTER_NAMES)
     if name in ("published", "published_closed_loop"):
         pub = published_filter()
         return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"))
     if name in ("designed", "designed_closed_loop", "designed_observer"):
-        from .synthesis import design_for_scenario
-
         if name == "designed_observer":
             options.setdefault("form", "observer")
         res = design_for_scenario(scenario, **options)
         return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=(name != "designed_closed_loop"))
-    from .ekf import build_ekf
-
     return build_ekf(scenario, known_input=(name == "ekf_known_input"), **options)
+
+
+_DESCRIPTIONS = {
+    "published": "Sun 2011's printed H-inf filter (delta_bar = 0.05), told the applied thrust",
+    "published_closed_loop": "the printed H-inf filter run verbatim as (12), assuming u = Kx",
+    "designed": "robust H-inf filter designed here (Corollary 1), told the applied thrust",
+    "designed_closed_loop": "the designed filter run verbatim as (12)",
+    "designed_observer": "robust H-inf filter constrained to observer form (extension), told the thrust",
+    "ekf": "EKF that does not know the control law (Sun 2011's comparison)",
+    "ekf_known_input": "EKF told the applied thrust",
+}
+
+
+def _fits(scenario):
+    return isinstance(scenario, Scenario)
+
+
+def _builder(name):
+    def build(scenario, **options):
+        return make_estimator(name, scenario, **options)
+
+    build.__name__ = f"build_{name}"
+    return build
+
+
+for _name in FILTER_NAMES:
+    register_estimator(_name, _builder(_name), fits=_fits, description=_DESCRIPTIONS[_name])

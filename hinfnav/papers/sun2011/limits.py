@@ -1,4 +1,4 @@
-"""The accuracy limit: steady-state Kalman (Riccati) error of the paper's model.
+"""The accuracy limit of Sun et al. (2011)'s scenario: steady-state Kalman (Riccati) error.
 
 With the noise model the simulation uses, x(k+1) = A x(k) + B w(k),
 y(k) = C x(k) + D v(k) with white unit-variance w and v ((6), (8)), no
@@ -34,81 +34,14 @@ a fixed LTI filter (12) when the plant is stable (the closed loop).
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
-from .exceptions import HinfnavError, InputError, UnstablePlantError
-from .hinfnorm import error_system_matrices
-from .models import measurement_matrix, spectral_radius
+from ...analysis.riccati import stationary_lti_error_covariance, steady_state_kalman
+from ...core.exceptions import InputError
+from ...core.validation import as_choice, as_matrix, as_real
+from ...systems.hill import measurement_matrix
 from .scenario import Scenario
-from .validation import as_choice, as_matrix, as_real
 
-__all__ = ["KalmanLimit", "steady_state_kalman", "kalman_limit", "lti_error_covariance"]
-
-
-def _as_cov(name, value, n, definite):
-    M = as_matrix(name, value, (n, n))
-    scale = max(float(np.max(np.abs(M))), np.finfo(float).tiny)
-    if not np.allclose(M, M.T, rtol=0, atol=1e-10 * scale):
-        raise InputError(f"{name} must be symmetric (a covariance matrix)")
-    M = 0.5 * (M + M.T)
-    low = float(np.min(np.linalg.eigvalsh(M)))
-    if definite and low <= 0:
-        raise InputError(f"{name} must be positive definite; its smallest eigenvalue is {low:.3g}")
-    if not definite and low < -1e-12 * scale:
-        raise InputError(f"{name} must be positive semidefinite; its smallest eigenvalue is {low:.3g}")
-    return M
-
-
-def steady_state_kalman(A, C, Q, R):
-    """Steady-state Kalman filter of ``x⁺ = A x + w``, ``y = C x + v``.
-
-    Parameters
-    ----------
-    A : array_like, shape (n, n)
-    C : array_like, shape (m, n)
-    Q : array_like, shape (n, n)
-        Covariance of w per step, positive semidefinite.
-    R : array_like, shape (m, m)
-        Covariance of v, positive definite.
-
-    Returns
-    -------
-    P_predicted : ndarray, shape (n, n)
-        A priori covariance P(k|k−1), the stabilizing solution of
-        ``P = A P Aᵀ − A P Cᵀ (C P Cᵀ + R)⁻¹ C P Aᵀ + Q``.
-    P_filtered : ndarray, shape (n, n)
-        A posteriori covariance ``P − P Cᵀ (C P Cᵀ + R)⁻¹ C P``.
-    gain : ndarray, shape (n, m)
-        Filter gain ``P Cᵀ (C P Cᵀ + R)⁻¹`` of the update
-        x̂(k|k) = x̂(k|k−1) + gain (y(k) − C x̂(k|k−1)).
-
-    Raises
-    ------
-    InputError
-        For bad shapes or covariances, or when the DARE has no stabilizing
-        solution ((A, C) not detectable).
-    """
-    A = as_matrix("A", A)
-    n = A.shape[0]
-    if A.shape != (n, n):
-        raise InputError(f"A must be square; got shape {A.shape}")
-    C = as_matrix("C", C, (None, n))
-    m = C.shape[0]
-    Q = _as_cov("Q", Q, n, definite=False)
-    R = _as_cov("R", R, m, definite=True)
-    try:
-        P = scipy.linalg.solve_discrete_are(A.T, C.T, Q, R)
-    except (np.linalg.LinAlgError, ValueError) as exc:
-        raise InputError(f"the Riccati equation has no stabilizing solution for this (A, C, Q, R): {exc}") from None
-    P = 0.5 * (P + P.T)
-    S = C @ P @ C.T + R
-    gain = np.linalg.solve(S, C @ P).T
-    Pf = P - gain @ S @ gain.T
-    Pf = 0.5 * (Pf + Pf.T)
-    residual = A @ Pf @ A.T + Q - P
-    if np.max(np.abs(residual)) > 1e-8 * max(1.0, np.max(np.abs(P))):
-        raise HinfnavError(f"the Riccati solution is inaccurate (residual {np.max(np.abs(residual)):.3g})")
-    return P, Pf, gain
+__all__ = ["KalmanLimit", "kalman_limit", "lti_error_covariance"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,13 +89,13 @@ class KalmanLimit:
         }
 
 
-def kalman_limit(scenario=None, maneuver=True, discretization="exact"):
+def kalman_limit(scenario, maneuver=True, discretization="exact"):
     """Steady-state Kalman error of the scenario's stated white-noise model.
 
     Parameters
     ----------
-    scenario : Scenario, optional
-        The paper's by default. Uses T, ω₀ (δ = 0), mass, K, B and D.
+    scenario : Scenario
+        Uses T, ω₀ (δ = 0), mass, K, B and D.
     maneuver : bool
         True: the closed loop u = K x of (3), A = Φ + Γ K (a filter that
         knows the control law). False: free motion, A = Φ.
@@ -193,9 +126,8 @@ def kalman_limit(scenario=None, maneuver=True, discretization="exact"):
     For the paper's numbers and the comparison with Table 1 see the module
     docstring: the paper's EKF (0.04 m, 0.001 m/s) is below this limit.
     """
-    scenario = Scenario() if scenario is None else scenario
     if not isinstance(scenario, Scenario):
-        raise InputError(f"scenario must be a hinfnav.Scenario; got {type(scenario).__name__}")
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     if not isinstance(maneuver, (bool, np.bool_)):
         raise InputError(f"maneuver must be True or False; got {maneuver!r}")
     as_choice("discretization", discretization, ("exact", "euler"))
@@ -218,7 +150,7 @@ def kalman_limit(scenario=None, maneuver=True, discretization="exact"):
 
 
 def lti_error_covariance(
-    A_F, B_F, C_F, scenario=None, *, maneuver=True, input_matrix=None, K=None, delta=0.0, discretization="exact"
+    A_F, B_F, C_F, scenario, *, maneuver=True, input_matrix=None, K=None, delta=0.0, discretization="exact"
 ):
     """Stationary error covariance of the LTI filter (12) on the closed loop.
 
@@ -265,46 +197,17 @@ def lti_error_covariance(
     InputError
         For bad shapes, a singular C_F, or an unstable filter.
     """
-    scenario = Scenario() if scenario is None else scenario
     if not isinstance(scenario, Scenario):
-        raise InputError(f"scenario must be a hinfnav.Scenario; got {type(scenario).__name__}")
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     if not isinstance(maneuver, (bool, np.bool_)):
         raise InputError(f"maneuver must be True or False; got {maneuver!r}")
     A_F = as_matrix("A_F", A_F, (6, 6))
     B_F = as_matrix("B_F", B_F, (6, 3))
     C_F = as_matrix("C_F", C_F, (6, 6))
-    if np.linalg.cond(C_F) > 1e12:
-        raise InputError("C_F must be invertible (the filter estimates the whole state)")
     delta = as_real("delta", delta)
     Phi, Gamma = scenario.truth_matrices(delta, discretization)
     K_truth = scenario.K if maneuver else np.zeros_like(scenario.K)
-    A_t = Phi + Gamma @ K_truth
-    rho = spectral_radius(A_t)
-    if rho >= 1:
-        raise UnstablePlantError(
-            f"the truth x(k+1) = A x(k) + B w(k) is not Schur stable (spectral radius {rho:.6f}); "
-            "its state, and the error of a filter without exact observer form, has no stationary covariance"
-        )
-    A_eff = A_F.copy()
-    M_u_gain = np.zeros((6, 3))
-    if (input_matrix is None) != (K is None):
-        raise InputError("input_matrix and K must be given together to use the known thrust")
-    if input_matrix is not None:
-        G = as_matrix("input_matrix", input_matrix, (6, 3))
-        K_F = as_matrix("K", K, (3, 6))
-        M = np.linalg.solve(C_F, G)
-        A_eff = A_F - M @ K_F @ C_F
-        M_u_gain = M
-    rho_f = spectral_radius(A_eff)
-    if rho_f >= 1:
-        raise InputError(f"A_F (with the input correction, if any) must be Schur stable; spectral radius {rho_f:.6f}")
-    C, B, D = measurement_matrix(), scenario.B, scenario.D
-    # The error system (13)-(14); the known thrust u = K_truth x enters the filter like an
-    # extra measurement channel: B_F C + M K_truth = [B_F, M] [C; K_truth], noise [D; 0].
-    Aa, Ba, Ca = error_system_matrices(
-        A_t, B, np.vstack([C, K_truth]), np.vstack([D, np.zeros((3, D.shape[1]))]), np.eye(6),
-        A_eff, np.hstack([B_F, M_u_gain]), C_F,
+    return stationary_lti_error_covariance(
+        Phi + Gamma @ K_truth, scenario.B, measurement_matrix(), scenario.D, A_F, B_F, C_F,
+        K_truth=K_truth, input_matrix=input_matrix, K=K,
     )
-    Sigma = scipy.linalg.solve_discrete_lyapunov(Aa, Ba @ Ba.T)
-    cov = Ca @ Sigma @ Ca.T
-    return 0.5 * (cov + cov.T)

@@ -12,119 +12,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .exceptions import InputError
-from .models import (
-    UncertainSystem,
+from ...control.feedback import LinearFeedback
+from ...core.exceptions import InputError
+from ...core.linalg import discretize
+from ...core.validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real, as_vector
+from ...sim.truth import TruthModel
+from ...systems.hill import (
     delta_A1,
-    discretize,
     hill_matrices,
+    hill_system,
     measurement_matrix,
+    position_measurement,
     uncertainty_structure,
 )
-from .validation import as_matrix, as_nonnegative, as_positive, as_real, as_vector
+from ...systems.uncertain import UncertainSystem
+from .constants import PAPER_K
 
-__all__ = [
-    "Scenario",
-    "PublishedFilter",
-    "PAPER_K",
-    "published_filter",
-    "infer_sampling_time",
-    "paper_scenario",
-]
+__all__ = ["Scenario", "paper_scenario", "DISCRETIZATIONS"]
 
-#: Feedback gain K of (3), N per (m, m/s); Section 4, from Gao, Yang & Shi (2009).
-PAPER_K = np.array(
-    [
-        [-2.2541, -0.0071, -0.0072, -22.3975, 2.3256, 1.9369],
-        [-0.0104, -2.2493, -0.0055, 2.3259, -23.7456, 1.4544],
-        [-0.0072, -0.0055, -2.2471, 1.9357, 1.4552, -24.2818],
-    ]
-)
-
-_PAPER_AF = np.array(
-    [
-        [-0.6126, -0.0053, -0.0046, 0.1, -1.7e-6, -1.0e-6],
-        [-0.0052, -0.6083, -0.0035, -1.5e-6, 0.1, -1.4e-6],
-        [-0.0046, -0.0035, -0.6066, -1.5e-6, -5.6e-7, 0.1],
-        [-6.1302, -0.0390, -0.0337, 0.9980, 1.1e-4, 8.2e-5],
-        [-0.0385, -6.0991, -0.0259, 8.0e-5, 0.9979, 6.3e-5],
-        [-0.0337, -0.0259, -6.0864, 8.3e-5, 6.4e-5, 0.9979],
-    ]
-)
-
-_PAPER_BF = np.array(
-    [
-        [-1.6126, -0.0053, -0.0046],
-        [-0.0052, -1.6083, -0.0035],
-        [-0.0046, -0.0035, -1.6066],
-        [-6.1300, -0.0390, -0.0337],
-        [-0.0385, -6.0989, -0.0259],
-        [-0.0337, -0.0259, -6.0862],
-    ]
-)
-
-# Printed as 1e-6 x [...] with -1e6 on the diagonal, i.e. C_F ≈ -I.
-_PAPER_CF = 1e-6 * np.array(
-    [
-        [-1e6, 0.0489, 0.0247, 6.3345, -5.4934, -4.3894],
-        [0.0386, -1e6, 0.0418, -5.3662, 10.3349, -2.9326],
-        [0.0420, 0.0148, -1e6, -4.5742, -2.9659, 11.3677],
-        [-0.3164, 0.3131, 0.1588, -999960, -33.635, -28.487],
-        [0.2469, -0.5593, 0.2630, -33.612, -999935, -19.564],
-        [0.2712, 0.0939, -0.5821, -28.520, -19.572, -999927],
-    ]
-)
-
-
-@dataclass(frozen=True, eq=False)
-class PublishedFilter:
-    """The filter (12) printed in Section 4 (δ̄ = 0.05, MATLAB LMI toolbox).
-
-    Attributes
-    ----------
-    A_F : ndarray, shape (6, 6)
-    B_F : ndarray, shape (6, 3)
-    C_F : ndarray, shape (6, 6)
-    delta_bar : float
-        The uncertainty bound it was designed for, 0.05.
-    """
-
-    A_F: np.ndarray
-    B_F: np.ndarray
-    C_F: np.ndarray
-    delta_bar: float = 0.05
-
-
-def published_filter():
-    """The published filter matrices A_F, B_F, C_F of Section 4 (copies)."""
-    return PublishedFilter(_PAPER_AF.copy(), _PAPER_BF.copy(), _PAPER_CF.copy())
-
-
-def infer_sampling_time(A_F=None, B_F=None):
-    """Infer the sampling time T from the published filter.
-
-    The paper never prints T. With the indirect measurement ``C = [I 0]``
-    the filter only acts on position through ``B_F C``, so its first three
-    rows keep the plant's structure ``A = I + T(A₁ + G₀K)``: the
-    position-to-position block is ``I + B_F[:3]`` (because ``C_F ≈ −I`` the
-    filter state is ``−x̂``) and the velocity-to-position block is ``T I``.
-    T is read off the mean diagonal of ``A_F[:3, 3:]``; the consistency of the
-    other block, ``A_F[:3, :3] − B_F[:3] = I``, is returned as a residual.
-
-    Returns
-    -------
-    T : float
-        Sampling time, s (0.1 for the published matrices).
-    residual : float
-        ``max |A_F[:3, :3] − B_F[:3, :] − I|`` (0 up to print rounding).
-    """
-    pub = published_filter()
-    A_F = pub.A_F if A_F is None else as_matrix("A_F", A_F, (6, 6))
-    B_F = pub.B_F if B_F is None else as_matrix("B_F", B_F, (6, 3))
-    T = float(np.mean(np.diag(A_F[:3, 3:])))
-    residual = float(np.max(np.abs(A_F[:3, :3] - B_F[:3, :] - np.eye(3))))
-    return T, residual
-
+#: Truth discretizations: exact zero-order hold (default) or the paper's Euler (6).
+DISCRETIZATIONS = ("exact", "euler")
 
 def _readonly(name, value, shape):
     arr = as_matrix(name, value, shape)
@@ -283,6 +190,62 @@ class Scenario:
         """Input matrix of the Euler design model, ``T G₀``, shape (6, 3)."""
         _, G0 = hill_matrices(self.omega0, self.mass)
         return self.dt * G0
+
+    # -- the objects the generic layers read ---------------------------------------
+
+    def system(self, delta=0.0, discretization="exact", *, closed_loop=False):
+        """The truth dynamics as a :class:`~hinfnav.systems.LinearSystem`.
+
+        Parameters
+        ----------
+        delta : float
+            True orbital-rate error δ of (4), > −1.
+        discretization : {"exact", "euler"}
+        closed_loop : bool
+            True: ``Φ + Γ K`` with no input (the model of a filter that assumes
+            u = K x). False: ``Φ`` with the thrust as input.
+        """
+        Phi, Gamma = self.truth_matrices(delta, discretization)
+        sysm = hill_system(self.omega0 * (1.0 + as_real("delta", delta)), self.mass, self.dt, self.B,
+                           discretization=discretization)
+        if closed_loop:
+            return dataclasses.replace(sysm, Phi=Phi + Gamma @ self.K, Gamma=np.zeros((6, 0)), input_labels=(),
+                                       input_units=(), name=sysm.name + " (closed loop u = Kx)")
+        return dataclasses.replace(sysm, Phi=Phi, Gamma=Gamma)
+
+    @property
+    def measurement(self):
+        """The indirect position measurement (8), ``y = [I 0] x + D v``."""
+        return position_measurement(self.D)
+
+    def controller(self, maneuver=True, source="truth"):
+        """The orbit-maneuver law u = K x of (3) (``source="estimate"``: u = K x̂), or None without maneuver."""
+        if not isinstance(maneuver, (bool, np.bool_)):
+            raise InputError(f"maneuver must be True or False; got {maneuver!r}")
+        return LinearFeedback(self.K, source=source, name="orbit maneuver u = Kx (3)") if maneuver else None
+
+    def truth_model(self, maneuver=True, delta=0.0, discretization="exact"):
+        """What the simulation layer needs: system, measurement, x₀, length and the law on the true state.
+
+        Parameters
+        ----------
+        maneuver : bool
+            True: u = K x (3). False: u = 0 (free Hill motion).
+        delta : float
+            True orbital-rate error δ of (4), > −1; not bound by δ̄.
+        discretization : {"exact", "euler"}
+
+        Returns
+        -------
+        hinfnav.sim.TruthModel
+        """
+        if not isinstance(maneuver, (bool, np.bool_)):
+            raise InputError(f"maneuver must be True or False; got {maneuver!r}")
+        delta = as_real("delta", delta)
+        as_choice("discretization", discretization, DISCRETIZATIONS)
+        settings = {"maneuver": bool(maneuver), "delta": delta, "discretization": discretization}
+        return TruthModel(self.system(delta, discretization), self.measurement, self.x0, self.n_steps,
+                          self.controller(bool(maneuver)), settings)
 
 
 def paper_scenario(**changes):

@@ -1,0 +1,42 @@
+"""Analysis layer: norms, certificates and Riccati limits, computed without an SDP solver.
+
+Nothing here imports cvxpy or trusts a solver's status.
+"""
+
+from .certificates import LMICertificate, brl_blocks, brl_matrix, certify_negative_definite, schur_gamma
+from .error_system import WorstCase, error_system, error_system_matrices, worst_case_norm
+from .norms import (
+    NORM_TOL,
+    channel_norms,
+    frequency_grid,
+    frequency_response_sigma,
+    h2_norm,
+    hinf_norm,
+    hinf_norm_bisection,
+    hinf_norm_grid,
+)
+from .observer import observer_form
+from .riccati import stationary_lti_error_covariance, steady_state_kalman
+
+__all__ = [
+    "NORM_TOL",
+    "hinf_norm",
+    "hinf_norm_bisection",
+    "hinf_norm_grid",
+    "h2_norm",
+    "frequency_grid",
+    "frequency_response_sigma",
+    "channel_norms",
+    "error_system",
+    "error_system_matrices",
+    "WorstCase",
+    "worst_case_norm",
+    "schur_gamma",
+    "certify_negative_definite",
+    "LMICertificate",
+    "brl_matrix",
+    "brl_blocks",
+    "stationary_lti_error_covariance",
+    "steady_state_kalman",
+    "observer_form",
+]

@@ -1,0 +1,158 @@
+"""The filtering error system (13)–(15) of Sun et al. (2011), and its worst sampled H∞ norm.
+
+For a plant ``x(k+1) = A x + B w``, ``y = C x + D v``, ``z = L x`` and a
+full-order filter ``x_f(k+1) = A_F x_f + B_F y``, ``z_f = C_F x_f``, the
+error ``e = z − z_f`` is the output of the augmented system
+``ξ = [x; x_f]`` driven by ``τ = [w; v]``.
+"""
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.linalg import spectral_radius
+from ..core.validation import as_matrix
+from .norms import NORM_TOL, _dt_value, hinf_norm
+
+__all__ = ["error_system_matrices", "error_system", "WorstCase", "worst_case_norm"]
+
+
+def error_system_matrices(A, B, C, D, L, A_F, B_F, C_F):
+    """State-space matrices of the filtering error system ε_d, (13)–(14).
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+        Plant matrix, possibly perturbed (``A + ΔA``, (14a)).
+    B : array_like, shape (n, p)
+        Process-noise matrix.
+    C : array_like, shape (m, n)
+        Measurement matrix.
+    D : array_like, shape (m, q)
+        Measurement-noise matrix.
+    L : array_like, shape (l, n)
+        Estimated signal ``z = L x``.
+    A_F, B_F, C_F : array_like, shapes (nf, nf), (nf, m), (l, nf)
+        The filter (12).
+
+    Returns
+    -------
+    Abar : ndarray, shape (n + nf, n + nf)
+        ``[[A, 0], [B_F C, A_F]]`` (14a).
+    Bbar : ndarray, shape (n + nf, p + q)
+        ``[[B, 0], [0, B_F D]]`` (14b); the input is ``τ = [w; v]``.
+    Cbar : ndarray, shape (l, n + nf)
+        ``[L, −C_F]`` (14c); the output is ``e = z − z_f``.
+    """
+    A = as_matrix("A", A)
+    n = A.shape[0]
+    if A.shape != (n, n):
+        raise InputError(f"A must be square; got shape {A.shape}")
+    B = as_matrix("B", B, (n, None))
+    C = as_matrix("C", C, (None, n))
+    m = C.shape[0]
+    D = as_matrix("D", D, (m, None))
+    L = as_matrix("L", L, (None, n))
+    A_F = as_matrix("A_F", A_F)
+    nf = A_F.shape[0]
+    if A_F.shape != (nf, nf):
+        raise InputError(f"A_F must be square; got shape {A_F.shape}")
+    B_F = as_matrix("B_F", B_F, (nf, m))
+    C_F = as_matrix("C_F", C_F, (L.shape[0], nf))
+    p, q = B.shape[1], D.shape[1]
+    Abar = np.block([[A, np.zeros((n, nf))], [B_F @ C, A_F]])
+    Bbar = np.block([[B, np.zeros((n, q))], [np.zeros((nf, p)), B_F @ D]])
+    Cbar = np.hstack([L, -C_F])
+    return Abar, Bbar, Cbar
+
+
+def error_system(A, B, C, D, L, A_F, B_F, C_F, dt=True):
+    """The error system ε_d of (13)–(15) as a discrete :class:`control.StateSpace`.
+
+    Parameters are those of :func:`error_system_matrices`, plus
+
+    dt : float or True, optional
+        Sampling time, s (``True``: discrete with unspecified period).
+
+    Returns
+    -------
+    control.StateSpace
+        ``Ψ(z) = C̄ (zI − Ā)⁻¹ B̄`` (15), from ``τ = [w; v]`` (p + q inputs) to
+        ``e = z − z_f`` (l outputs), no feedthrough.
+    """
+    Abar, Bbar, Cbar = error_system_matrices(A, B, C, D, L, A_F, B_F, C_F)
+    return control.ss(Abar, Bbar, Cbar, np.zeros((Cbar.shape[0], Bbar.shape[1])), _dt_value(dt))
+
+
+@dataclass(frozen=True, eq=False)
+class WorstCase:
+    """H∞ norms of the error system at sampled uncertainties.
+
+    Attributes
+    ----------
+    norms : ndarray, shape (k,)
+        ``‖Ψ‖∞`` at each sample (``inf`` where the error system is unstable).
+    spectral_radii : ndarray, shape (k,)
+        Spectral radius of ``Ā`` at each sample.
+    peak_frequencies : ndarray, shape (k,)
+        Peak frequency at each sample, rad/s (rad/sample when dt is True).
+    index : int
+        Index of the worst sample.
+    """
+
+    norms: np.ndarray
+    spectral_radii: np.ndarray
+    peak_frequencies: np.ndarray
+    index: int
+
+    @property
+    def norm(self):
+        """Largest sampled norm (``inf`` if any sample is unstable)."""
+        return float(self.norms[self.index])
+
+    @property
+    def stable(self):
+        """Whether the error system is Schur stable at every sample."""
+        return bool(np.all(self.spectral_radii < 1.0))
+
+
+def worst_case_norm(system, A_F, B_F, C_F, samples=None, dt=None, tol=NORM_TOL):
+    """Worst sampled H∞ norm of the error system (13)–(15) of a filter.
+
+    Parameters
+    ----------
+    system : hinfnav.models.UncertainSystem
+        The uncertain plant ψ_d (9)–(11), with ``A + H F E``.
+    A_F, B_F, C_F : array_like
+        The filter (12).
+    samples : sequence of array_like, optional
+        Uncertainty matrices F (shape (r, r) of ``system.H``/``system.E``); a
+        ``None`` entry means F = 0. Default: F = 0 only.
+    dt : float or True, optional
+        Sampling time of the returned frequencies; default ``system.dt``.
+    tol : float, optional
+        Relative accuracy of each norm.
+
+    Returns
+    -------
+    WorstCase
+    """
+    if samples is None:
+        samples = [None]
+    dt = system.dt if dt is None else _dt_value(dt)
+    norms, radii, peaks = [], [], []
+    for F in samples:
+        Ap = system.A if F is None else system.perturbed_A(F)
+        sys = error_system(Ap, system.B, system.C, system.D, system.L, A_F, B_F, C_F, dt)
+        radii.append(spectral_radius(sys.A))
+        g, f = hinf_norm(sys, tol, return_peak=True)
+        norms.append(g)
+        peaks.append(f)
+    norms = np.array(norms)
+    if len(norms) == 0:
+        raise InputError("samples must contain at least one uncertainty matrix F")
+    return WorstCase(norms, np.array(radii), np.array(peaks), int(np.argmax(norms)))
+
+

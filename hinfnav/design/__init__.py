@@ -1,0 +1,22 @@
+"""Design layer: generic, certified robust filter synthesis (no scenario defaults).
+
+Every filter returned is certified with :mod:`hinfnav.analysis`, whatever
+the solver reported.
+"""
+
+from ..lmi.solve import SOLVERS, SolverOptions
+from .result import SynthesisResult
+from .robust_hinf import FORMS, synthesize
+from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
+
+__all__ = [
+    "synthesize",
+    "SynthesisResult",
+    "SolverOptions",
+    "SOLVERS",
+    "FORMS",
+    "SampleSet",
+    "default_uncertainty_samples",
+    "check_samples",
+    "check_plant",
+]

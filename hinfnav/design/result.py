@@ -1,0 +1,114 @@
+"""The result of a certified robust filter synthesis."""
+
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+
+from ..analysis.error_system import error_system
+
+__all__ = ["SynthesisResult"]
+
+
+
+
+@dataclass(frozen=True, eq=False)
+class SynthesisResult:
+    """A certified robust H∞ filter (12) from Theorem 1 / Corollary 1.
+
+    Attributes
+    ----------
+    A_F : ndarray, shape (n, n)
+    B_F : ndarray, shape (n, m)
+    C_F : ndarray, shape (l, n)
+        The filter ``x_f(k+1) = A_F x_f(k) + B_F y(k)``, ``z_f = C_F x_f``,
+        rebuilt by (21), in the plant's (unscaled) state coordinates.
+    gamma : float
+        Certified level: LMI (20) holds (float64 eigenvalue test) at the
+        returned filter with this γ, so ``‖Ψ‖∞ < gamma`` for every admissible
+        F (Theorem 1); every sampled norm is ≤ ``gamma``.
+    lmi_gamma : float
+        The γ the solver reached (minimum of Corollary 1, or the last feasible
+        level of the bisection).
+    verified_norm : float
+        Largest H∞ norm of the error system (13)–(15) over the samples
+        (SLICOT ab13dd), a lower bound of the true worst case.
+    sample_norms : ndarray, shape (k,)
+        The norm at each uncertainty sample.
+    worst_sample : int
+        Index of the worst sample.
+    spectral_radius : float
+        Largest spectral radius of the error system over the samples (< 1).
+    solver : str
+        Solver of the accepted solution.
+    solve_time_s : float
+        Wall time spent in the solvers (all attempts), s.
+    total_time_s : float
+        Wall time of the whole synthesis with certification, s.
+    method : str
+        ``"minimize"`` (Corollary 1 directly) or ``"bisection"``.
+    dt : float or True
+        Sampling time of :meth:`statespace`.
+    variables : dict
+        LMI variables in the original coordinates: ``R``, ``S``, ``Abar_F``,
+        ``Bbar_F``, ``Cbar_F`` (= ``S A_F``, ``S B_F``, ``C_F``), ``lam``; and
+        the balanced uncertainty factors ``H``, ``E`` they go with (``None``
+        for a nominal design).
+    attempts : tuple of str
+        Log of the solves tried and why each was accepted or refused.
+    structure : str
+        Uncertainty structure assumed (``"diagonal"`` or ``"full"``).
+    samples : tuple
+        The uncertainty matrices F that were checked.
+    delta_bar : float or None
+        Bound of the uncertain parameter when the samples came from a
+        :class:`~hinfnav.design.samples.SampleSet` that has one (δ̄ of Sun
+        et al. 2011).
+    deltas : ndarray or None
+        The parameter value of each sample (same order as ``sample_norms``),
+        from the sample set.
+    sample_labels : tuple of str
+        A label per sample (e.g. ``"δ = 0.05"``).
+    form : str
+        ``"general"`` (LMI (20) as in the paper) or ``"observer"`` (filter
+        constrained to ``C_F = −L``, ``A_F = A + B_F C``; see :func:`synthesize`).
+    """
+
+    A_F: np.ndarray
+    B_F: np.ndarray
+    C_F: np.ndarray
+    gamma: float
+    lmi_gamma: float
+    verified_norm: float
+    sample_norms: np.ndarray
+    worst_sample: int
+    spectral_radius: float
+    solver: str
+    solve_time_s: float
+    total_time_s: float
+    method: str
+    dt: object = True
+    variables: dict = field(default_factory=dict)
+    attempts: tuple = ()
+    structure: str = "full"
+    samples: tuple = ()
+    delta_bar: float = None
+    deltas: np.ndarray = None
+    form: str = "general"
+    sample_labels: tuple = ()
+
+    def statespace(self):
+        """The filter as a discrete :class:`control.StateSpace` (y → z_f), with ``dt``."""
+        return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
+
+    @property
+    def worst_delta(self):
+        """Parameter value (δ) of the worst sample (None when the samples carry no values)."""
+        return None if self.deltas is None else float(self.deltas[self.worst_sample])
+
+    def error_system(self, system, F=None):
+        """Error system (13)–(15) of this filter on ``system`` at uncertainty F."""
+        Ap = system.A if F is None else system.perturbed_A(F)
+        return error_system(Ap, system.B, system.C, system.D, system.L, self.A_F, self.B_F, self.C_F, self.dt)
+
+

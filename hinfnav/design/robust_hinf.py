@@ -1,0 +1,463 @@
+"""Certified robust H∞ filter synthesis by LMI: Theorem 1 and Corollary 1 of Sun et al. (2011).
+
+:func:`synthesize` solves
+
+    min γ²  subject to LMI (20) in R, S, Ā_F, B̄_F, C̄_F, λ      (Corollary 1)
+
+and rebuilds the filter (12) by (21): ``A_F = S⁻¹Ā_F``, ``B_F = S⁻¹B̄_F``,
+``C_F = C̄_F``. The returned filter is *certified*, independently of the
+solver's status:
+
+1. LMI (20) is evaluated in float64 at the returned filter
+   (``Ā_F = S A_F``, ``B̄_F = S B_F``) and the solver's R, S, λ, and the
+   smallest γ making it negative definite is found by a Schur complement and
+   confirmed by an eigenvalue test (:func:`hinfnav.analysis.schur_gamma`).
+   By Theorem 1 that γ bounds ``‖Ψ‖∞`` for every admissible F (10)–(11).
+   This γ is the result's ``gamma``.
+2. The H∞ norm of the error system (13)–(15) is computed (SLICOT ab13dd) at
+   sampled uncertainties; every sample must be Schur stable with a norm
+   ≤ ``gamma``.
+
+The numerics (dropping, balancing, power-of-two scaling) are in
+:mod:`hinfnav.lmi.conditioning`; the solver choices in one
+:class:`~hinfnav.lmi.SolverOptions`. When the direct minimization of γ² does
+not certify, or certifies a γ more than ``rtol`` above the solver's, γ is
+bisected with feasibility problems that maximize the margin t in
+(20) ≤ −t·I; a problem with no solution for any γ is recognized by the γ-free
+part of (20) having no interior point
+(:class:`~hinfnav.core.exceptions.InfeasibleLMIError`).
+
+With ``form="observer"`` the filter is constrained to a predictor observer
+(``C_F = −L``, ``A_F = A + B_F C``; see :func:`synthesize`).
+
+Nothing here knows about a paper's scenario: the uncertain system comes in as
+matrices, the uncertainty samples as a :class:`~hinfnav.design.SampleSet`.
+"""
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.certificates import schur_gamma
+from ..analysis.error_system import WorstCase, worst_case_norm
+from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError
+from ..core.validation import as_choice, as_int_at_least, as_positive
+from ..lmi.blocks import gamma_index, lmi20_matrix
+from ..lmi.conditioning import prepare
+from ..lmi.solve import INFEASIBLE, SolverOptions, solve_lmi
+from ..systems.uncertain import UncertainSystem
+from .result import SynthesisResult
+from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
+
+__all__ = ["FORMS", "synthesize"]
+
+#: Filter structures :func:`synthesize` accepts.
+FORMS = ("general", "observer")
+
+
+@dataclass
+class _Check:
+    ok: bool
+    reason: str
+    gamma: float = float("inf")
+    A_F: np.ndarray = None
+    B_F: np.ndarray = None
+    C_F: np.ndarray = None
+    wc: WorstCase = None
+    variables: dict = None
+
+
+def _rebuild_and_certify(P, sol, system, samples, dt):
+    """Filter by (21), LMI certificate, sampled norms (internal)."""
+    n = P.A.shape[0]
+    condS = np.linalg.cond(sol.S)
+    if not np.isfinite(condS) or condS > 1e14:
+        return _Check(False, f"S is singular to working precision (cond {condS:.3g}); (21) cannot be applied")
+    sig = P.sigma
+    # (21) in scaled coordinates
+    BFs = np.linalg.solve(sol.S, sol.Bbar_F)
+    if P.form == "observer":
+        # the structure is imposed on the returned filter itself, in the original coordinates
+        # (S⁻¹(S Ã + B̄_F C̃) equals Ã + B̃_F C̃ only to round-off): B_F = Σ B̃_F, C_F = −L,
+        # A_F = A + B_F C; the certificate below is evaluated at exactly this filter, scaled back
+        # by powers of two (exact): Ã_F = Σ⁻¹ A_F Σ, C̃_F = C_F Σ = −L̃
+        B_F_obs = sig[:, None] * BFs
+        A_F_obs = system.A + B_F_obs @ system.C
+        AFs = A_F_obs * sig[None, :] / sig[:, None]
+        CFs = -P.L
+    else:
+        AFs = np.linalg.solve(sol.S, sol.Abar_F)
+        CFs = sol.Cbar_F
+    if not (np.all(np.isfinite(AFs)) and np.all(np.isfinite(BFs)) and np.all(np.isfinite(CFs))):
+        return _Check(False, "the rebuilt filter has non-finite entries")
+    # certificate: (20) at the returned filter (Abar_F = S A_F, Bbar_F = S B_F)
+    M0 = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, sol.R, sol.S, sol.S @ AFs, sol.S @ BFs, CFs, sol.lam, 0.0)
+    p, q = P.B.shape[1], P.D.shape[1]
+    gamma_c, info = schur_gamma(M0, gamma_index(n, p, q))
+    # undo the state scaling exactly (powers of two): x_f = Σ x̃_f
+    if P.form == "observer":
+        A_F, B_F, C_F = A_F_obs, B_F_obs, -system.L
+    else:
+        A_F = sig[:, None] * AFs / sig[None, :]
+        B_F = sig[:, None] * BFs
+        C_F = CFs / sig[None, :]
+    Si = 1.0 / sig
+    variables = {
+        "R": Si[:, None] * sol.R * Si[None, :],
+        "S": Si[:, None] * sol.S * Si[None, :],
+        "lam": sol.lam,
+        "H": P.H_balanced,
+        "E": P.E_balanced,
+    }
+    variables["Abar_F"] = variables["S"] @ A_F
+    variables["Bbar_F"] = variables["S"] @ B_F
+    variables["Cbar_F"] = C_F.copy()
+    if not np.isfinite(gamma_c):
+        return _Check(
+            False,
+            f"LMI (20) is not negative definite at the solver's variables for any γ "
+            f"(largest eigenvalue of its γ-free part {info['max_eig_OO']:.3g})",
+            A_F=A_F,
+            B_F=B_F,
+            C_F=C_F,
+        )
+    wc = worst_case_norm(system, A_F, B_F, C_F, samples, dt=1.0)
+    if not wc.stable:
+        return _Check(
+            False,
+            f"error system not Schur stable at sample {int(np.argmax(wc.spectral_radii))} "
+            f"(spectral radius {np.max(wc.spectral_radii):.10g})",
+            gamma_c,
+            A_F,
+            B_F,
+            C_F,
+            wc,
+        )
+    if wc.norm > gamma_c * (1.0 + 1e-9):
+        return _Check(
+            False,
+            f"sampled H∞ norm {wc.norm:.10g} exceeds the LMI-certified level {gamma_c:.10g}",
+            gamma_c,
+            A_F,
+            B_F,
+            C_F,
+            wc,
+        )
+    return _Check(True, "certified", gamma_c, A_F, B_F, C_F, wc, variables)
+
+
+def synthesize(
+    A,
+    B,
+    C,
+    D,
+    L,
+    H=None,
+    E=None,
+    *,
+    dt=True,
+    structure="full",
+    uncertainty_samples=None,
+    n_random_samples=4,
+    seed=0,
+    form="general",
+    options=None,
+    solver=None,
+):
+    """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+        Plant matrix (must be Schur stable for every admissible F).
+    B : array_like, shape (n, p)
+        Process-noise matrix.
+    C : array_like, shape (m, n)
+        Measurement matrix.
+    D : array_like, shape (m, q)
+        Measurement-noise matrix.
+    L : array_like, shape (l, n)
+        Estimated signal ``z = L x``.
+    H, E : array_like, shapes (n, r) and (r, n), optional
+        ``ΔA = H F E`` with ``FᵀF ≤ I`` (10)–(11). Leave out (or give zeros)
+        for the nominal H∞ filter.
+    dt : float or True, optional
+        Sampling time of :meth:`SynthesisResult.statespace` (True: discrete,
+        unspecified).
+    structure : {"full", "diagonal"}, optional
+        Whether F is any contraction or diagonal (as in the paper, Section 4);
+        decides how H and E are balanced (see :func:`prepare_uncertainty`)
+        and which default samples are checked.
+    uncertainty_samples : SampleSet or sequence of array_like, optional
+        Contractions F (shape (r, r)) at which the error system is checked;
+        default :func:`default_uncertainty_samples`. A :class:`SampleSet`
+        also carries a label per sample and the parameter value behind it
+        (returned as ``deltas``/``delta_bar``).
+    n_random_samples : int, optional
+        Random contractions in the default samples.
+    seed : int or numpy.random.Generator, optional
+        Seed of the random samples.
+    form : {"general", "observer"}, optional
+        ``"general"`` (default): LMI (20) as in the paper, any full-order
+        filter (12). ``"observer"``: the filter is constrained to a
+        predictor observer, ``C_F = −L`` and ``A_F = A + B_F C`` (see Notes);
+        needs ``L`` square and invertible.
+    options : SolverOptions, optional
+        Every solver choice (solvers and their order, method, margins,
+        tolerances, bisection, polishing, state scaling); default
+        ``SolverOptions()``.
+    solver : str, optional
+        Shorthand for ``SolverOptions.only(solver)``: this solver only (not
+        together with ``options``).
+
+    Returns
+    -------
+    SynthesisResult
+
+    Raises
+    ------
+    InputError
+        Mismatched shapes, non-finite entries, bad options (an unknown
+        ``form``, or ``form="observer"`` with ``L`` not square and invertible).
+    UnstablePlantError
+        ``A + H F E`` is not Schur stable at some sample (no finite γ).
+    InfeasibleLMIError
+        Every solver found LMI (20) infeasible (message carries the status).
+    CertificationError
+        No solution passed the certification (message says why).
+
+    Notes
+    -----
+    Theorem 1 / Corollary 1, LMI (20), filter (21). The error system is
+    (13)–(15); its norm bound (16) holds for all F with ``FᵀF ≤ I``. The
+    LMI is the paper's, with a single multiplier λ (Lemma 2): for diagonal F
+    it is conservative.
+
+    **Observer form.** With ``C_F = −L`` and, for ``L = I``, ``x̂ = −x_f``,
+    the predictor observer ``x̂⁺ = A x̂ + G (y − C x̂)`` reads
+    ``x_f⁺ = (A − G C) x_f − G y``: it is the filter (12) with
+    ``B_F = −G`` and ``A_F = A + B_F C``. By (21), ``A_F = S⁻¹Ā_F`` and
+    ``B_F = S⁻¹B̄_F``, so multiplying by S turns these into constraints that
+    are *linear* in the LMI variables::
+
+        C̄_F = −L,      Ā_F = S A + B̄_F C.
+
+    They are added to (20) by substitution (Ā_F and C̄_F are no longer free
+    variables), so Corollary 1 with them is still an SDP and its optimum
+    γ_observer ≥ γ* (a restriction). The estimation error
+    ``e = x − x̂ = x + x_f`` then obeys
+
+        e⁺ = (A − G C) e + ΔA x + B w − G D v,
+
+    which does not involve the plant trajectory at ΔA = 0: an initial
+    state, or a thrust the filter is told exactly, does not leak into the
+    error (the general optimum's error depends on x). For an invertible
+    ``L ≠ I`` the same filter estimates ``z = L x`` by ``z_f = L x̂`` (its
+    error is ``L e``); :func:`observer_form`, which compares
+    ``C_F A_F C_F⁻¹`` with A, reports a zero residual only for ``L = I``.
+
+    The state scaling ``x = Σ x̃`` of the numerics is applied to the
+    constraints as well (``C̄_F = −L Σ``, ``Ā_F = S Σ⁻¹AΣ + B̄_F C Σ``), and
+    the returned filter is rebuilt in the original coordinates as
+    ``B_F = Σ S⁻¹B̄_F``, ``A_F = A + B_F C``, ``C_F = −L``: the identities
+    hold to the round-off of one product and sum. The solvers get the
+    substituted LMI in a congruent form, :func:`observer_lmi_matrix` (in the
+    coordinates (x, e); on (20) itself they stall near the optimum).
+    Certification is unchanged: (20) by eigenvalues at exactly the returned
+    filter, and the sampled norms.
+
+    The derivation itself only uses ``C_F = −L`` (the filter state is
+    always a full state estimate); ``L`` is required square and invertible
+    so that ``x̂ = C_F x_f`` is that estimate, as in the paper (L = I).
+    """
+    t_start = time.perf_counter()
+    system = UncertainSystem(A, B, C, D, L, H, E, dt=1.0)
+    dt_value = True if dt is True else as_positive("dt", dt)
+    structure = as_choice("structure", structure, ("full", "diagonal"))
+    n_random_samples = as_int_at_least("n_random_samples", n_random_samples, 0)
+    if options is None:
+        options = SolverOptions.only(solver)
+    elif solver is not None:
+        raise InputError("give either solver or options (SolverOptions(solvers=...)), not both")
+    elif not isinstance(options, SolverOptions):
+        raise InputError(f"options must be a hinfnav.SolverOptions; got {type(options).__name__}")
+    method, margin, accuracy, rtol = options.method, options.margin, options.accuracy, options.rtol
+    max_bisection, polish = options.max_bisection, options.polish
+    if not isinstance(form, str):
+        raise InputError(f"form must be a string, one of {', '.join(FORMS)}; got {form!r}")
+    form = as_choice("form", form, FORMS)
+    if form == "observer":
+        n_state, l_out = system.A.shape[0], system.L.shape[0]
+        if l_out != n_state:
+            raise InputError(
+                f"form='observer' needs the filter to estimate the whole state: L must be square and invertible, "
+                f"got L of shape {l_out}x{n_state}"
+            )
+        condL = np.linalg.cond(system.L)
+        if not condL < 1e12:
+            raise InputError(
+                f"form='observer' needs L square and invertible (C_F = −L); L is singular (cond {condL:.3g})"
+            )
+    solvers = list(options.solvers)
+    if system.H is not None and not (np.any(system.H) and np.any(system.E)):
+        system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, None, None, 1.0)
+    sample_set = uncertainty_samples if isinstance(uncertainty_samples, SampleSet) else None
+    if uncertainty_samples is None:
+        samples = default_uncertainty_samples(system, structure, n_random_samples, seed)
+    elif sample_set is not None:
+        samples = check_samples(list(sample_set.matrices), system, structure)
+    else:
+        samples = check_samples(list(uncertainty_samples), system, structure)
+    checked_samples = samples if system.H is not None else [None]
+    labels = None if sample_set is None else sample_set.labels
+    check_plant(system, checked_samples, labels)
+
+    state_scaling = options.state_scaling if isinstance(options.state_scaling, str) else np.array(options.state_scaling)
+    P = prepare(system, structure, state_scaling, form)
+    log = []
+    statuses = []
+    candidates = []
+    times = [0.0]
+
+    def certify(sol):
+        times[0] += sol.seconds
+        if sol.R is None:
+            return None
+        return _rebuild_and_certify(P, sol, system, checked_samples, dt_value)
+
+    for slv in solvers:
+        # once a solution is certified, the other solvers only polish it (one minimization each)
+        how = method if not candidates else "minimize"
+        found = _run_solver(P, slv, how, margin, accuracy, rtol, max_bisection, certify, log, statuses)
+        candidates.extend(found)
+        if candidates and not polish:
+            break
+
+    if candidates:
+        chk, sol, slv, how = min(candidates, key=lambda c: c[0].gamma)
+        return SynthesisResult(
+            A_F=chk.A_F,
+            B_F=chk.B_F,
+            C_F=chk.C_F,
+            gamma=float(chk.gamma),
+            lmi_gamma=float(math.sqrt(max(sol.gamma2, 0.0))),
+            verified_norm=chk.wc.norm,
+            sample_norms=chk.wc.norms,
+            worst_sample=chk.wc.index,
+            spectral_radius=float(np.max(chk.wc.spectral_radii)),
+            solver=slv,
+            solve_time_s=times[0],
+            total_time_s=time.perf_counter() - t_start,
+            method=how,
+            dt=dt_value,
+            variables=chk.variables,
+            attempts=tuple(log),
+            structure=structure,
+            samples=tuple(checked_samples),
+            delta_bar=None if sample_set is None else sample_set.bound,
+            deltas=None if sample_set is None else sample_set.values,
+            form=form,
+            sample_labels=() if sample_set is None else sample_set.labels,
+        )
+    if any(st in INFEASIBLE or st.startswith("infeasible") for _, st in statuses):
+        hint = (
+            " With structure='full' F may be any contraction; if F is diagonal (as in the paper), "
+            "structure='diagonal' balances H and E channel by channel and is less conservative."
+            if structure == "full" and system.H is not None and min(system.H.shape[1], system.E.shape[0]) > 1
+            else ""
+        )
+        if form == "observer":
+            hint += (
+                " The observer-form constraints (C_F = −L, A_F = A + B_F C) were imposed; "
+                "form='general' may be feasible."
+            )
+        raise InfeasibleLMIError(
+            "LMI (20) is infeasible: no R, S, λ make the error system quadratically stable for every admissible F, "
+            "so Theorem 1 gives no filter for any γ (solver status: "
+            + "; ".join(f"{slv} {st}" for slv, st in statuses)
+            + ")."
+            + hint
+        )
+    raise CertificationError(
+        "no solution of LMI (20) passed certification (LMI eigenvalue test at the rebuilt filter and H∞ norms of "
+        "the error system at the uncertainty samples); last attempts: " + " | ".join(log[-5:])
+    )
+
+
+def _run_solver(P, slv, method, margin, accuracy, rtol, max_bisection, certify, log, statuses):
+    """Minimize, then bisect if needed, with one solver; certified candidates (internal)."""
+    cands = []
+    lo = 0.0
+    if method in ("auto", "minimize"):
+        sol = solve_lmi(P, slv, margin, accuracy)
+        statuses.append((slv, sol.status))
+        chk = certify(sol)
+        if chk is None:
+            log.append(f"{slv} minimize: status {sol.status}, no solution")
+            if method == "minimize" or sol.status in INFEASIBLE:
+                return cands
+        else:
+            lmi_g = math.sqrt(max(sol.gamma2, 0.0))
+            log.append(f"{slv} minimize: status {sol.status}, solver γ = {lmi_g:.10g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
+            if chk.ok:
+                cands.append((chk, sol, slv, "minimize"))
+                if method == "minimize" or chk.gamma <= lmi_g * (1.0 + rtol):
+                    return cands
+            elif method == "minimize":
+                return cands
+            # the solver's γ is a lower-bound hint only: bisection never returns an uncertified point
+            lo = lmi_g * (1.0 - (10.0 * rtol if sol.status == "optimal" else 1e-2))
+            if not chk.ok and lmi_g > 0:
+                # the solver's point is (slightly) infeasible: look for a certifiable level just above it
+                for step in (1e-4, 1e-3, 1e-2, 1e-1, 1.0):
+                    level = lmi_g * (1.0 + step)
+                    sol2 = solve_lmi(P, slv, margin, accuracy, gamma2=level**2)
+                    chk2 = certify(sol2)
+                    if chk2 is not None and sol2.margin > 0 and chk2.ok:
+                        log.append(f"{slv} feasibility at γ = {level:.10g}: margin {sol2.margin:.3g}, certified γ = {chk2.gamma:.10g}")
+                        cands.append((chk2, sol2, slv, "bisection"))
+                        break
+                    log.append(f"{slv} feasibility at γ = {level:.10g}: status {sol2.status}, not certified")
+    # bisection on γ with maximum-margin feasibility problems
+    hi = min((c[0].gamma for c in cands), default=None)
+    if hi is None:
+        # the most interior point of the γ-free part of (20): feasible iff (20) is for some γ
+        sol = solve_lmi(P, slv, margin, accuracy, gamma2="free")
+        chk = certify(sol)
+        if chk is None:
+            log.append(f"{slv} γ-free feasibility: status {sol.status}, no solution")
+            statuses.append((slv, sol.status))
+            return cands
+        if not sol.margin > 0:
+            log.append(f"{slv} γ-free feasibility: status {sol.status}, largest margin {sol.margin:.3g} <= 0")
+            statuses.append((slv, f"infeasible (status {sol.status}, largest margin t = {sol.margin:.3g} <= 0)"))
+            return cands
+        log.append(f"{slv} γ-free feasibility: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
+        if not chk.ok:
+            return cands
+        sol.gamma2 = chk.gamma**2
+        cands.append((chk, sol, slv, "bisection"))
+        hi = chk.gamma
+    if lo >= hi:
+        lo = 0.0  # the solver's γ was no lower bound (it is above a certified level): start from scratch
+    for _ in range(max_bisection):
+        if hi - lo <= rtol * hi:
+            break
+        mid = 0.5 * (lo + hi)
+        sol = solve_lmi(P, slv, margin, accuracy, gamma2=mid**2)
+        chk = certify(sol)
+        if chk is None or not sol.margin > 0:
+            log.append(f"{slv} feasibility at γ = {mid:.10g}: status {sol.status}, margin {sol.margin:.3g}: infeasible")
+            lo = mid
+            continue
+        log.append(f"{slv} feasibility at γ = {mid:.10g}: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
+        if chk.ok and chk.gamma < hi:
+            cands.append((chk, sol, slv, "bisection"))
+            hi = chk.gamma
+        if not chk.ok or chk.gamma > mid:
+            lo = mid  # the solver's claim of feasibility at this level is not confirmed
+    return cands
+
+

@@ -1,0 +1,25 @@
+"""Estimators layer: the step contract and the estimators built on it.
+
+Never imports the design or simulation layers: a designed filter comes in as
+matrices.
+"""
+
+from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+from .kalman import OUTPUTS, ExtendedKalmanFilter
+from .lti import LTIFilter
+from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
+
+__all__ = [
+    "Estimator",
+    "EstimateHistory",
+    "FilterState",
+    "StepOutput",
+    "check_estimator_inputs",
+    "LTIFilter",
+    "ExtendedKalmanFilter",
+    "OUTPUTS",
+    "register_estimator",
+    "build_estimator",
+    "registered_estimators",
+    "estimator_entry",
+]

@@ -1,0 +1,267 @@
+"""The estimator step contract, shared by every estimator of the workbook.
+
+An estimator is built on a system (:class:`hinfnav.systems.LinearSystem` or
+another object with ``n``, ``dt``, ``state`` …) and a measurement model
+(:class:`hinfnav.systems.MeasurementModel`). It runs in two ways:
+
+**Per step**, so that it can sit inside a control loop::
+
+    state = est.start(xhat0, P0, runs=R)        # x̂(0|−1) = xhat0
+    for k in range(n_samples):
+        state, out = est.update(state, y[:, k])  # out.xhat: estimate at t_k
+        u_k = controller(out.xhat)               # may use the estimate
+        state = est.predict(state, u_k)          # to t_{k+1}
+
+``update`` consumes the measurement y_k at t_k and returns the estimate the
+filter reports at t_k (filtered x̂(k|k), or predicted x̂(k|k−1) for a
+predictor such as the LTI filter (12)), its covariance if it carries one and
+diagnostics (innovation, weights, fading factors …). ``predict`` takes the
+input u_k held over [t_k, t_{k+1}) (ignored unless ``uses_input``).
+:meth:`Estimator.step` does both.
+
+**In batch** over (runs, n_samples) histories: :meth:`Estimator.estimate`
+loops over the steps with all runs at once; a subclass may override it with a
+faster path that gives the same numbers (tested by the contract suite).
+
+Variants override one hook: the Huber filter the correction, a strong-tracking
+filter the covariance prediction, an augmented filter the system it is built
+on, a saturated-measurement filter the update when a channel is clipped.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.validation import as_vector
+
+__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs"]
+
+
+@dataclass
+class FilterState:
+    """What an estimator carries from one step to the next (all runs at once).
+
+    Attributes
+    ----------
+    x : ndarray, shape (runs, n_x)
+        The estimator's internal state (the prior estimate before ``update``).
+    P : ndarray, shape (runs, n, n) or (n, n) or None
+        Covariance; a 2-D array is shared by every run (data-independent gains).
+    k : int
+        Index of the next measurement.
+    extra : dict
+        Anything else a filter keeps (last measurement, posterior, windows).
+    """
+
+    x: np.ndarray
+    P: np.ndarray = None
+    k: int = 0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def runs(self):
+        return self.x.shape[0]
+
+
+@dataclass(frozen=True, eq=False)
+class StepOutput:
+    """What ``update`` reports at t_k.
+
+    Attributes
+    ----------
+    xhat : ndarray, shape (runs, n)
+    P : ndarray, shape (runs, n, n) or (n, n) or None
+    diagnostics : dict
+        Name → array with leading dimension runs (``innovation`` …).
+    """
+
+    xhat: np.ndarray
+    P: np.ndarray = None
+    diagnostics: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class EstimateHistory:
+    """Estimate histories of a batch of runs.
+
+    Attributes
+    ----------
+    xhat : ndarray, shape (runs, n_samples, n)
+        Estimate at each t_k.
+    P : ndarray, shape (runs, n_samples, n, n), or None
+        Covariance the filter believes in (None for filters without one).
+    state : StateSpec or None
+        Labels, units and groups of the estimated state.
+    diagnostics : dict
+        Name → array (runs, n_samples, ...), when asked for.
+    """
+
+    xhat: np.ndarray
+    P: np.ndarray = None
+    state: object = None
+    diagnostics: dict = field(default_factory=dict)
+
+    @property
+    def labels(self):
+        """State labels (from the system)."""
+        return None if self.state is None else self.state.labels
+
+    @property
+    def units(self):
+        """State units (from the system)."""
+        return None if self.state is None else self.state.units
+
+
+def check_estimator_inputs(y, u, xhat0, n_state, n_meas=None, n_input=None):
+    """Validate the arguments of :meth:`Estimator.estimate`; return float arrays."""
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 3:
+        raise InputError(f"y must have shape (runs, n_samples, n_meas); got {y.shape}")
+    if n_meas is not None and y.shape[2] != n_meas:
+        raise InputError(f"y must have {n_meas} measurement channels; got {y.shape[2]}")
+    if not np.all(np.isfinite(y)):
+        raise InputError("y (the measurements) must contain only finite numbers; it has NaN or inf entries")
+    u = np.asarray(u, dtype=float)
+    if u.ndim != 3 or u.shape[:2] != y.shape[:2]:
+        raise InputError(f"u must have shape (runs, n_samples, n_input) matching y {y.shape[:2]}; got {u.shape}")
+    if n_input is not None and u.shape[2] != n_input:
+        raise InputError(f"u must have {n_input} input channels; got {u.shape[2]}")
+    if not np.all(np.isfinite(u)):
+        raise InputError("u (the inputs) must contain only finite numbers; it has NaN or inf entries")
+    xhat0 = as_vector("xhat0", xhat0, n_state)
+    return y, u, xhat0
+
+
+class Estimator:
+    """Base class of the estimators (see the module docstring).
+
+    Parameters
+    ----------
+    system : LinearSystem (or compatible)
+        Gives ``n``, ``n_input``, ``dt`` and ``state`` (labels, units, error).
+    measurement : MeasurementModel
+        Gives ``n_meas``, h, its Jacobian and R.
+    name : str
+
+    Attributes
+    ----------
+    uses_input : bool
+        Whether ``predict`` uses the input u.
+    vectorized : bool
+        Whether one call of :meth:`estimate` processes all runs at once
+        (True for every estimator on the step contract).
+    """
+
+    name = "estimator"
+    uses_input = False
+    vectorized = True
+
+    def __init__(self, system, measurement, *, name=None):
+        for attr in ("n", "dt", "state"):
+            if not hasattr(system, attr):
+                raise InputError(f"system must be a hinfnav system (with n, dt, state); got {type(system).__name__}")
+        if not hasattr(measurement, "n_meas"):
+            raise InputError(f"measurement must be a hinfnav MeasurementModel; got {type(measurement).__name__}")
+        if measurement.n_state != system.n:
+            raise InputError(f"measurement acts on {measurement.n_state} states but the system has {system.n}")
+        self.system = system
+        self.measurement = measurement
+        if name is not None:
+            self.name = str(name)
+
+    # -- dimensions ---------------------------------------------------------
+
+    @property
+    def n_state(self):
+        """Dimension of the estimated state."""
+        return self.system.n
+
+    @property
+    def n_input(self):
+        """Number of input channels the estimator accepts."""
+        return getattr(self.system, "n_input", 0)
+
+    @property
+    def dt(self):
+        """Sampling time, s."""
+        return self.system.dt
+
+    # -- the step contract --------------------------------------------------
+
+    def start(self, xhat0, P0=None, runs=1):
+        """Initial filter state for ``runs`` runs, with prior estimate ``xhat0``."""
+        raise NotImplementedError
+
+    def update(self, state, y):
+        """Consume y_k (shape (runs, n_meas)); return ``(state, StepOutput)``."""
+        raise NotImplementedError
+
+    def predict(self, state, u=None):
+        """Propagate to t_{k+1} with the input u_k (shape (runs, n_input)); return the state."""
+        raise NotImplementedError
+
+    def step(self, state, y, u=None):
+        """``update`` with y_k, then ``predict`` with u_k; returns ``(state, StepOutput)``."""
+        state, out = self.update(state, y)
+        return self.predict(state, u), out
+
+    # -- batch --------------------------------------------------------------
+
+    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
+        """Estimate the state histories of a batch of runs.
+
+        Parameters
+        ----------
+        y : array_like, shape (runs, n_samples, n_meas)
+            Measurements y(k) at t_k.
+        u : array_like, shape (runs, n_samples, n_input)
+            Inputs applied over [t_k, t_{k+1}).
+        xhat0 : array_like, shape (n,)
+            Prior estimate of x(0).
+        P0 : array_like, shape (n, n), optional
+            Initial covariance (filters that carry one; their default otherwise).
+        keep_covariance : bool
+            Return the covariance history.
+        diagnostics : bool
+            Return the diagnostics histories.
+
+        Returns
+        -------
+        EstimateHistory
+        """
+        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
+                                             self.n_input if self.uses_input else None)
+        runs, n1, _ = y.shape
+        state = self.start(xhat0, P0, runs)
+        xhat = np.empty((runs, n1, self.n_state))
+        P_hist = None
+        shared = False
+        diag = {}
+        for k in range(n1):
+            state, out = self.update(state, y[:, k])
+            xhat[:, k] = out.xhat
+            if keep_covariance and out.P is not None:
+                if P_hist is None:
+                    # a covariance shared by every run (broadcast, stride 0) is stored once
+                    shared = out.P.ndim == 2 or out.P.strides[0] == 0
+                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + out.P.shape[-2:])
+                if shared:
+                    P_hist[k] = out.P if out.P.ndim == 2 else out.P[0]
+                else:
+                    P_hist[:, k] = out.P
+            if diagnostics:
+                for key, val in out.diagnostics.items():
+                    val = np.asarray(val)
+                    if key not in diag:
+                        diag[key] = np.empty((runs, n1) + val.shape[1:], dtype=val.dtype)
+                    diag[key][:, k] = val
+            if k < n1 - 1:
+                state = self.predict(state, u[:, k])
+        if shared:
+            P_hist.setflags(write=False)
+            P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
+        return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state, diagnostics=diag)
+
+    def __repr__(self):
+        return f"<{type(self).__name__} {self.name!r} uses_input={self.uses_input}>"

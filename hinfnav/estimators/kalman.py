@@ -1,0 +1,142 @@
+"""Kalman filters on the step contract: the linear/extended Kalman filter, batched over runs.
+
+:class:`ExtendedKalmanFilter` propagates a linear system (its Jacobian is Φ)
+and linearizes the measurement model at the prior estimate. It is one
+class with small hooks that the variants override:
+
+* :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``
+  (strong tracking multiplies by fading factors);
+* :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
+  (the Huber filter replaces it by an M-estimation);
+* the system it is built on (augmented and extended-state filters append
+  states to it).
+
+With a linear measurement and one initial covariance for all runs the
+covariance and gain do not depend on the data: P is then carried once (2-D)
+and shared by every run, so a batch of R runs costs one covariance recursion.
+The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
+(Joseph form), which ``tests/test_estimators_kalman.py`` checks run by run.
+"""
+
+import numpy as np
+
+from ..core.exceptions import HinfnavError, InputError
+from ..core.linalg import as_covariance
+from ..core.validation import as_choice
+from .base import Estimator, FilterState, StepOutput
+
+__all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
+
+#: What ``update`` reports at t_k: x̂(k|k) or x̂(k|k−1).
+OUTPUTS = ("filtered", "predicted")
+
+
+class ExtendedKalmanFilter(Estimator):
+    """Extended Kalman filter of a linear system with any measurement model.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        Φ, Γ, B (Q = B Bᵀ by default), dt, state labels.
+    measurement : MeasurementModel
+        h, its Jacobian, R = D Dᵀ by default, residual (angles wrapped).
+    P0 : array_like, shape (n, n)
+        Default initial covariance (positive definite); ``start`` may override it.
+    Q : array_like, shape (n, n), optional
+        Process-noise covariance per step (positive semidefinite).
+    R : array_like, shape (m, m), optional
+        Measurement-noise covariance (positive definite).
+    uses_input : bool
+        Propagate with the applied input, ``Φ x̂ + Γ u`` (True), or ignore u.
+    output : {"filtered", "predicted"}
+        What ``update`` reports: x̂(k|k) (uses y_k) or x̂(k|k−1).
+    name : str
+    """
+
+    name = "ekf"
+
+    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None):
+        super().__init__(system, measurement, name=name)
+        n, m = system.n, measurement.n_meas
+        self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
+        self.R = as_covariance("R", measurement.R if R is None else R, m, definite=True)
+        self.P0 = as_covariance("P0", P0, n, definite=True)
+        if not isinstance(uses_input, (bool, np.bool_)):
+            raise InputError(f"uses_input must be True or False; got {uses_input!r}")
+        self.uses_input = bool(uses_input)
+        self.output = as_choice("output", output, OUTPUTS)
+        self.F = system.Phi
+        self.Gamma = system.Gamma
+        self._I = np.eye(n)
+
+    @property
+    def shares_covariance(self):
+        """True when P and the gain do not depend on the data (linear measurement)."""
+        return bool(self.measurement.linear)
+
+    # -- hooks ------------------------------------------------------------------
+
+    def predict_mean(self, x, u):
+        """``Φ x̂ (+ Γ u)`` for a batch of estimates."""
+        out = x @ self.F.T
+        if self.uses_input:
+            out = out + u @ self.Gamma.T
+        return out
+
+    def predict_covariance(self, P, state):
+        """``Φ P Φᵀ + Q`` (P shared (n, n) or per run (runs, n, n))."""
+        return self.F @ P @ self.F.T + self.Q
+
+    def correct(self, x, P, H, innovation, state):
+        """Joseph-form Kalman update; returns ``(x⁺, P⁺, diagnostics)``.
+
+        ``H`` is (m, n) when P is shared, (runs, m, n) otherwise.
+        """
+        HT = np.swapaxes(H, -1, -2)
+        PHT = P @ HT
+        S = H @ PHT + self.R
+        K = PHT @ np.linalg.inv(S)
+        if K.ndim == 2:
+            x_post = x + innovation @ K.T
+        else:
+            x_post = x + np.einsum("rij,rj->ri", K, innovation)
+        I_KH = self._I - K @ H
+        P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ self.R @ np.swapaxes(K, -1, -2)
+        return x_post, P_post, {}
+
+    # -- the step contract --------------------------------------------------------
+
+    def start(self, xhat0, P0=None, runs=1):
+        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
+        x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
+        if not self.shares_covariance:
+            P = np.broadcast_to(P, (runs,) + P.shape).copy()
+        return FilterState(x=x, P=P)
+
+    def update(self, state, y):
+        x, P = state.x, state.P
+        y = np.asarray(y, dtype=float)
+        try:
+            H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
+            innovation = self.measurement.residual(y, self.measurement.function(x))
+        except InputError as exc:
+            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
+        x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        diag = dict(diag, innovation=innovation)
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
+        if self.output == "filtered":
+            out = StepOutput(xhat=x_post, P=self._broadcast(P_post, x.shape[0]), diagnostics=diag)
+        else:
+            out = StepOutput(xhat=x, P=self._broadcast(P, x.shape[0]), diagnostics=diag)
+        return new, out
+
+    def predict(self, state, u=None):
+        if self.uses_input and u is None:
+            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+        x = self.predict_mean(state.x, None if u is None else np.asarray(u, dtype=float))
+        P = self.predict_covariance(state.P, state)
+        extra = {key: val for key, val in state.extra.items() if key != "prior"}
+        return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
+
+    def _broadcast(self, P, runs):
+        return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P

@@ -1,0 +1,29 @@
+"""LMI layer: the only part of hinfnav that imports cvxpy.
+
+LMI blocks, conditioning and scaling, the solver strategy object and one
+solve; the robust bounded real LMI for a fixed filter. Solutions are never
+trusted here: :mod:`hinfnav.design` certifies them with :mod:`hinfnav.analysis`.
+"""
+
+from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
+from .conditioning import Prepared, pow2, prepare, prepare_uncertainty, state_scaling
+from .robust_brl import robust_bounded_real_lmi
+from .solve import INFEASIBLE, METHODS, SOLVERS, Solution, SolverOptions, solve_lmi
+
+__all__ = [
+    "lmi20_matrix",
+    "observer_lmi_matrix",
+    "gamma_index",
+    "Prepared",
+    "prepare",
+    "prepare_uncertainty",
+    "state_scaling",
+    "pow2",
+    "SOLVERS",
+    "METHODS",
+    "INFEASIBLE",
+    "SolverOptions",
+    "Solution",
+    "solve_lmi",
+    "robust_bounded_real_lmi",
+]

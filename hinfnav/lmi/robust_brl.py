@@ -1,0 +1,94 @@
+"""The robust bounded real LMI for a fixed filter, solved by cvxpy (Lemmas 1–3).
+
+Gives a certified upper bound of the worst-case H∞ norm over every
+norm-bounded uncertainty for a given error system; the solution is checked by
+:func:`hinfnav.analysis.certificates.schur_gamma`.
+"""
+
+import warnings
+
+import cvxpy as cp
+import numpy as np
+
+from ..analysis.certificates import LMICertificate, brl_blocks, schur_gamma
+from ..core.linalg import sym
+from ..core.exceptions import InputError
+from ..core.validation import as_matrix
+
+__all__ = ["robust_bounded_real_lmi"]
+
+
+def robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None, margin=1e-9):
+    """Certified upper bound of ``‖C̄(zI − Ā − H̄FĒ)⁻¹B̄‖∞`` over ``FᵀF ≤ I``.
+
+    Minimizes γ² subject to the bounded real lemma (Lemma 1, (17)), with the
+    uncertainty ``Ā + H̄ F Ē`` removed by Lemma 2 and the Schur complement
+    (Lemma 3), exactly as in the proof of Theorem 1 but for a fixed filter::
+
+        [ −P   PĀ             PB̄     0    PH̄  ]
+        [  *  −P + λĒᵀĒ       0      C̄ᵀ   0   ]
+        [  *   *             −γ²I    0    0   ]  < 0
+        [  *   *              *     −I    0   ]
+        [  *   *              *      *   −λI  ]
+
+    Without ``Hbar`` it is Lemma 1 alone (the nominal norm, up to solver
+    accuracy). The returned ``gamma`` is certified by :func:`schur_gamma` at
+    the solver's ``P`` and ``λ``, not taken from the solver.
+
+    Parameters
+    ----------
+    Abar : array_like, shape (N, N)
+    Bbar : array_like, shape (N, k)
+    Cbar : array_like, shape (l, N)
+    Hbar : array_like, shape (N, r1), optional
+    Ebar : array_like, shape (r2, N), optional
+    solver : str, optional
+        cvxpy solver name; default: Clarabel and CVXOPT, the smaller
+        certified bound is kept.
+    margin : float, optional
+        Strictness margin: the LMI is imposed as ``≤ −margin·I``.
+
+    Returns
+    -------
+    LMICertificate
+    """
+    Abar = as_matrix("Abar", Abar)
+    N = Abar.shape[0]
+    Bbar = as_matrix("Bbar", Bbar, (N, None))
+    Cbar = as_matrix("Cbar", Cbar, (None, N))
+    if (Hbar is None) != (Ebar is None):
+        raise InputError("Hbar and Ebar must be given together")
+    if Hbar is not None:
+        Hbar = as_matrix("Hbar", Hbar, (N, None))
+        Ebar = as_matrix("Ebar", Ebar, (None, N))
+    solvers = ("CLARABEL", "CVXOPT") if solver is None else (solver,)
+    best = None
+    for slv in solvers:
+        cert = _robust_brl_once(Abar, Bbar, Cbar, Hbar, Ebar, slv, margin)
+        if best is None or cert.gamma < best.gamma:
+            best = cert
+    return best
+
+
+def _robust_brl_once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin):
+    N = Abar.shape[0]
+    P = cp.Variable((N, N), symmetric=True)
+    lam = cp.Variable() if Hbar is not None else 0.0
+    g = cp.Variable()
+    M = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, cp.bmat)
+    size = M.shape[0]
+    prob = cp.Problem(cp.Minimize(g), [0.5 * (M + M.T) << -margin * np.eye(size)])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prob.solve(solver=solver)
+    except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: solver error ({exc})")
+    if P.value is None:
+        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: {prob.status}")
+    Pv = sym(P.value)
+    lamv = float(lam.value) if Hbar is not None else 0.0
+    M0 = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, Pv, lamv, 0.0, np.block)
+    nin = Bbar.shape[1]
+    gamma, _ = schur_gamma(M0, np.arange(2 * N, 2 * N + nin))
+    return LMICertificate(gamma, float(np.sqrt(max(g.value, 0.0))), Pv, lamv, f"{solver}: {prob.status}")

@@ -1,0 +1,27 @@
+"""Metrics layer: error statistics of simulated runs, for any state."""
+
+from .errors import (
+    MonteCarloSummary,
+    axes_rms,
+    by_group,
+    convergence_time,
+    group_rms,
+    max_error,
+    monte_carlo_summary,
+    rms_error,
+    rms_per_run,
+    window_mask,
+)
+
+__all__ = [
+    "window_mask",
+    "rms_error",
+    "rms_per_run",
+    "max_error",
+    "convergence_time",
+    "MonteCarloSummary",
+    "monte_carlo_summary",
+    "by_group",
+    "group_rms",
+    "axes_rms",
+]

@@ -1,0 +1,73 @@
+"""Sun et al. (2011), "Relative navigation algorithm for chaser satellite based on robust H∞ filtering".
+
+Journal of Astronautics 32(7):1462–1470, doi:10.3873/j.issn.1000-1328.2011.07.005.
+Its constants and published filter (:mod:`.constants`), scenario
+(:mod:`.scenario`), EKF baseline (:mod:`.ekf`), registered filters
+(:mod:`.filters`), designs (:mod:`.designs`), accuracy limits
+(:mod:`.limits`), Table 1 (:mod:`.table1`), figures (:mod:`.figures`),
+studies (:mod:`.studies`, :mod:`.closed_loop`) and ``reproduce``.
+"""
+
+from .closed_loop import ClosedLoopStudy, closed_loop_study, plot_closed_loop
+from .constants import CITATION, DEFAULT_DELTA_BARS, PAPER_K, PAPER_TABLE1, PublishedFilter, infer_sampling_time, published_filter
+from .designs import (
+    GammaSweep,
+    compare_with_published,
+    delta_grid,
+    delta_samples,
+    design_for_scenario,
+    design_report,
+    format_design_report,
+    gamma_sweep,
+)
+from .ekf import EKF, build_ekf, range_angle_measurements
+from .filters import FILTER_NAMES, lti_from_matrices, make_estimator
+from .limits import KalmanLimit, kalman_limit, lti_error_covariance
+from .reproduce import reproduce
+from .scenario import Scenario, paper_scenario
+from .studies import format_robustness_table, pos_vel, robustness_table, simulation_comparison, stationary_std, sweep_result
+from .table1 import Table1, format_table1, table1, table1_rows, write_table1
+
+__all__ = [
+    "CITATION",
+    "PAPER_K",
+    "PAPER_TABLE1",
+    "DEFAULT_DELTA_BARS",
+    "PublishedFilter",
+    "published_filter",
+    "infer_sampling_time",
+    "Scenario",
+    "paper_scenario",
+    "EKF",
+    "build_ekf",
+    "range_angle_measurements",
+    "FILTER_NAMES",
+    "make_estimator",
+    "lti_from_matrices",
+    "KalmanLimit",
+    "kalman_limit",
+    "lti_error_covariance",
+    "delta_grid",
+    "delta_samples",
+    "design_for_scenario",
+    "GammaSweep",
+    "gamma_sweep",
+    "design_report",
+    "format_design_report",
+    "compare_with_published",
+    "Table1",
+    "table1",
+    "table1_rows",
+    "format_table1",
+    "write_table1",
+    "robustness_table",
+    "format_robustness_table",
+    "simulation_comparison",
+    "stationary_std",
+    "sweep_result",
+    "pos_vel",
+    "ClosedLoopStudy",
+    "closed_loop_study",
+    "plot_closed_loop",
+    "reproduce",
+]

@@ -1,0 +1,259 @@
+"""Table 1 of Sun et al. (2011), reproduced: EKF and H∞ filters with and without maneuver.
+
+Conventions (the paper does not state them; see the notebooks for why):
+
+* error measure: per-axis RMS of x − x̂ over ``scenario.rms_window_s``
+  (100–1000 s); a table cell is the RMS over the three axes of those
+  per-axis values (all three are close to each other);
+* single run: run 0 of the Monte Carlo set (the paper shows one run);
+* Monte Carlo: mean over runs of the per-run value, with the 95 % confidence
+  interval of that mean, and the 2.5–97.5 % spread of single runs;
+* noise: white Gaussian w, v (the paper's Table 1 text);
+* all filters see the same truth and measurements in each case;
+* the H∞ filters run exactly as (12) with maneuver (the closed loop u = Kx
+  they were designed on) and are told the applied thrust without maneuver
+  (see :func:`hinfnav.papers.sun2011.filters.lti_from_matrices`).
+"""
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ...core.validation import as_int_at_least
+from ...metrics.errors import axes_rms, rms_per_run
+from ...sim.montecarlo import run_estimator
+from ...sim.truth import simulate_truth
+from .constants import PAPER_TABLE1, published_filter
+from .designs import design_for_scenario
+from .filters import lti_from_matrices, make_estimator
+from .limits import kalman_limit
+from .scenario import Scenario
+
+__all__ = ["TABLE_FILTERS", "CASES", "Table1", "table1", "table1_rows", "format_table1", "write_table1", "case_cell"]
+
+#: Filters of the reproduced table: key -> (label, builder name)
+TABLE_FILTERS = {
+    "ekf": "EKF (paper: control law unknown)",
+    "ekf_known_input": "EKF (knows the thrust)",
+    "hinf_published": "H∞, published A_F, B_F, C_F",
+    "hinf_designed": "H∞, designed here (δ̄ = 0.05)",
+    "hinf_observer": "H∞, designed in observer form (extension)",
+}
+
+CASES = {"no_maneuver": False, "maneuver": True}
+
+
+def _estimators(scenario, designed, maneuver, observer=None):
+    """The filters of the table; H∞ filters verbatim (12) with maneuver, told the thrust without."""
+    pub = published_filter()
+    told = not maneuver
+    est = {
+        "ekf": make_estimator("ekf", scenario),
+        "ekf_known_input": make_estimator("ekf_known_input", scenario),
+        "hinf_published": lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name="published", uses_input=told),
+    }
+    if designed is not None:
+        est["hinf_designed"] = lti_from_matrices(designed.A_F, designed.B_F, designed.C_F, scenario, name="designed",
+                                                 uses_input=told)
+    if observer is not None:
+        est["hinf_observer"] = lti_from_matrices(observer.A_F, observer.B_F, observer.C_F, scenario,
+                                                 name="designed_observer", uses_input=told)
+    return est
+
+
+@dataclass(frozen=True, eq=False)
+class Table1:
+    """Reproduced Table 1.
+
+    Attributes
+    ----------
+    cells : dict
+        ``cells[case][filter]`` → dict with ``pos_m``, ``vel_mps`` (single
+        run, RMS over axes of the per-axis RMS), ``pos_axes_m``,
+        ``vel_axes_mps`` (3 each), ``mc_mean_pos_m``, ``mc_ci95_pos_m``
+        ([lo, hi]), ``mc_spread95_pos_m``, and the same for velocity.
+        ``case`` is ``no_maneuver`` or ``maneuver``.
+    ekf_windows : dict
+        The paper-variant EKF with maneuver over 0–500 s and 500–1000 s.
+    kalman_limit : dict
+        Steady-state Kalman (Riccati) error per case (see :mod:`hinfnav.kalman`).
+    settings : dict
+    """
+
+    cells: dict
+    ekf_windows: dict
+    kalman_limit: dict
+    settings: dict = field(default_factory=dict)
+
+
+def case_cell(result, t, window):
+    """One Table 1 cell: single-run and Monte Carlo position and velocity RMS of a result."""
+    per_run = rms_per_run(result.error, t, window)  # (runs, n)
+    state = result.state
+    pos_axes, vel_axes = state.select(per_run, "position"), state.select(per_run, "velocity")
+    pos_run = np.sqrt(np.mean(pos_axes**2, axis=1))
+    vel_run = np.sqrt(np.mean(vel_axes**2, axis=1))
+    out = {
+        "pos_m": float(pos_run[0]),
+        "vel_mps": float(vel_run[0]),
+        "pos_axes_m": [float(v) for v in pos_axes[0]],
+        "vel_axes_mps": [float(v) for v in vel_axes[0]],
+    }
+    for key, vals in (("pos_m", pos_run), ("vel_mps", vel_run)):
+        n = vals.size
+        mean = float(vals.mean())
+        half = float(1.96 * vals.std(ddof=1) / np.sqrt(n)) if n > 1 else 0.0
+        out[f"mc_mean_{key}"] = mean
+        out[f"mc_ci95_{key}"] = [mean - half, mean + half]
+        out[f"mc_spread95_{key}"] = [float(v) for v in np.percentile(vals, [2.5, 97.5])]
+    return out
+
+
+def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False):
+    """Compute the reproduced Table 1.
+
+    Parameters
+    ----------
+    scenario : Scenario, optional
+        Defaults to the paper's.
+    runs : int
+        Monte Carlo runs per case (≥ 1; 100 or more for the interval).
+    seed : int
+    designed : SynthesisResult, optional
+        The δ̄ = 0.05 filter from :func:`hinfnav.synthesize`; designed here when
+        None (about a second).
+    observer : SynthesisResult, optional
+        The δ̄ = 0.05 filter designed in observer form (an extension of the
+        paper); designed here when None.
+    progress : bool
+
+    Returns
+    -------
+    Table1
+    """
+    scenario = Scenario() if scenario is None else scenario
+    runs = as_int_at_least("runs", runs, 1)
+    if designed is None:
+        designed = design_for_scenario(scenario, delta_bar=0.05)
+    if observer is None:
+        observer = design_for_scenario(scenario, delta_bar=0.05, form="observer")
+    win = scenario.rms_window_s
+    cells, ekf_windows, klim = {}, {}, {}
+    total = len(CASES) * len(_estimators(scenario, designed, True, observer))
+    with tqdm(total=total, disable=not progress, desc="Table 1", unit="filter") as bar:
+        for case, maneuver in CASES.items():
+            truth = simulate_truth(scenario.truth_model(maneuver=maneuver), runs=runs, seed=seed)
+            cells[case] = {}
+            for key, est in _estimators(scenario, designed, maneuver, observer).items():
+                res = run_estimator(est, truth, scenario.xhat0)
+                cells[case][key] = case_cell(res, truth.t, win)
+                if case == "maneuver" and key == "ekf":
+                    for label, w in (("0-500 s", (0.0, 500.0)), ("100-500 s", (100.0, 500.0)), ("500-1000 s", (500.0, 1000.0))):
+                        ekf_windows[label] = case_cell(res, truth.t, w)
+                del res
+                bar.update(1)
+            for key, paper_key in (("paper_ekf", "ekf"), ("paper_hinf", "hinf")):
+                cells[case][key] = dict(PAPER_TABLE1[case][paper_key])
+            klim[case] = kalman_limit(scenario, maneuver=maneuver).as_dict()
+    settings = {
+        "runs": runs,
+        "seed": seed,
+        "dt_s": scenario.dt,
+        "duration_s": scenario.duration_s,
+        "window_s": list(win),
+        "noise": "gaussian (white, unit variance, scaled by B and D)",
+        "truth_discretization": "exact (zero-order hold)",
+        "error_measure": (
+            "per-axis RMS of x - xhat over window_s; a cell is the RMS over x, y, z of the per-axis values; "
+            "pos_m/vel_mps: single run (run 0, as the paper reports); mc_*: over all runs"
+        ),
+        "hinf_input": "H-inf filters run verbatim as (12) with maneuver, told the applied thrust without",
+        "designed_gamma": float(designed.gamma),
+        "designed_lmi_gamma": float(designed.lmi_gamma),
+        "observer_gamma": float(observer.gamma),
+    }
+    return Table1(cells=cells, ekf_windows=ekf_windows, kalman_limit=klim, settings=settings)
+
+
+def _kl_axes(kl, predicted=False):
+    """(pos_m, vel_mps) scalars (RMS over axes) of a kalman_limit record (filtered or predicted)."""
+    suffix = "_predicted" if predicted else ""
+    return axes_rms(kl["pos_m" + suffix]), axes_rms(kl["vel_mps" + suffix])
+
+
+def table1_rows(tab):
+    """Rows (list of dicts) of the reproduced table, paper values beside them."""
+    rows = []
+    for case in CASES:
+        for key, label in [("paper_ekf", "paper: EKF"), ("paper_hinf", "paper: H∞")] + list(TABLE_FILTERS.items()):
+            c = tab.cells[case].get(key)
+            if c is None:
+                continue
+            row = {"case": case.replace("_", " "), "filter": label, "pos_m": c["pos_m"], "vel_mps": c["vel_mps"]}
+            if "mc_mean_pos_m" in c:
+                row.update(
+                    mc_pos_m=c["mc_mean_pos_m"], mc_pos_ci95=c["mc_ci95_pos_m"],
+                    mc_vel_mps=c["mc_mean_vel_mps"], mc_vel_ci95=c["mc_ci95_vel_mps"],
+                )
+            rows.append(row)
+        for predicted, label in ((False, "Kalman limit, filtered (uses y(k))"), (True, "Kalman limit, predicted (y up to k-1, like (12))")):
+            kp, kv = _kl_axes(tab.kalman_limit[case], predicted)
+            rows.append({"case": case.replace("_", " "), "filter": label, "pos_m": kp, "vel_mps": kv})
+    return rows
+
+
+def _fmt(v, digits=3):
+    if v is None:
+        return "—"
+    if isinstance(v, (list, tuple)):
+        return f"[{_fmt(v[0], digits)}, {_fmt(v[1], digits)}]"
+    return f"{v:.{digits}g}"
+
+
+def format_table1(tab, markdown=False):
+    """Paper-vs-reproduced Table 1 as text (plain or Markdown)."""
+    rows = table1_rows(tab)
+    runs = tab.settings.get("runs")
+    head = ["case", "filter", "pos (m), 1 run", "vel (m/s), 1 run", f"pos (m), mean of {runs} [95% CI]",
+            f"vel (m/s), mean of {runs} [95% CI]"]
+    body = []
+    for r in rows:
+        mc_p = f"{_fmt(r['mc_pos_m'])} {_fmt(r['mc_pos_ci95'])}" if "mc_pos_m" in r else ""
+        mc_v = f"{_fmt(r['mc_vel_mps'])} {_fmt(r['mc_vel_ci95'])}" if "mc_vel_mps" in r else ""
+        body.append([r["case"], r["filter"], _fmt(r["pos_m"]), _fmt(r["vel_mps"]), mc_p, mc_v])
+    if markdown:
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(b) + " |" for b in body]
+        return "\n".join(lines)
+    widths = [max(len(str(x)) for x in col) for col in zip(head, *body)]
+    fmt = lambda cells: "  ".join(str(c).ljust(w) for c, w in zip(cells, widths))  # noqa: E731
+    return "\n".join([fmt(head), fmt(["-" * w for w in widths])] + [fmt(b) for b in body])
+
+
+def write_table1(tab, out_dir):
+    """Write ``table1.csv`` and ``table1.md`` into ``out_dir``; return their paths."""
+    out_dir = Path(out_dir)
+    rows = table1_rows(tab)
+    csv_path = out_dir / "table1.csv"
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["case", "filter", "pos_m_single_run", "vel_mps_single_run", "pos_m_mc_mean", "pos_m_mc_ci95_lo",
+                    "pos_m_mc_ci95_hi", "vel_mps_mc_mean", "vel_mps_mc_ci95_lo", "vel_mps_mc_ci95_hi"])
+        for r in rows:
+            mc = [r.get("mc_pos_m"), *(r.get("mc_pos_ci95") or [None, None]), r.get("mc_vel_mps"),
+                  *(r.get("mc_vel_ci95") or [None, None])]
+            w.writerow([r["case"], r["filter"], r["pos_m"], r["vel_mps"], *mc])
+    md_path = out_dir / "table1.md"
+    md_path.write_text(
+        "# Table 1: relative navigation accuracy, paper vs reproduced\n\n"
+        + format_table1(tab, markdown=True)
+        + "\n\nError measure: " + tab.settings["error_measure"] + ".\n"
+        + f"Window {tab.settings['window_s'][0]:g}-{tab.settings['window_s'][1]:g} s, T = {tab.settings['dt_s']:g} s, "
+        + f"{tab.settings['runs']} Monte Carlo runs, seed {tab.settings['seed']}.\n"
+    )
+    return csv_path, md_path
+
+

@@ -1,0 +1,19 @@
+"""Simulation layer: open-loop truth, closed loop, Monte Carlo with seeding and batching."""
+
+from .closed_loop import simulate_closed_loop
+from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate
+from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
+
+__all__ = [
+    "TruthModel",
+    "Truth",
+    "SimulationResult",
+    "simulate_truth",
+    "simulate",
+    "run_estimator",
+    "resolve_estimator",
+    "simulate_closed_loop",
+    "child_rngs",
+    "noise_models",
+    "draw_noise",
+]

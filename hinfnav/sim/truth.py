@@ -1,0 +1,172 @@
+"""Open-loop truth: a system driven by noise, an optional feedback on the true state, measured.
+
+::
+
+    x(k+1) = Φ x(k) + Γ u(k) + B w(k),    u(k) = K x(k) (or none)
+    y(k)   = h(x(k)) + D v(k)
+
+w and v are unit-variance noise sequences from :mod:`hinfnav.noise`. A
+feedback on the *true* state does not depend on any estimator, so one truth
+can feed several estimators.
+
+Randomness: run ``r`` draws its noise from the ``r``-th child of
+``numpy.random.default_rng(seed).spawn(runs)``, w first then v, whole
+histories at once. The same seed gives the same numbers, whatever the batch
+size.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.validation import as_int_at_least, as_vector
+from ..noise import make_noise
+
+__all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth"]
+
+
+@dataclass(frozen=True, eq=False)
+class TruthModel:
+    """Everything that defines a truth simulation (what a scenario hands to :mod:`hinfnav.sim`).
+
+    Attributes
+    ----------
+    system : LinearSystem
+        The true dynamics (Φ, Γ, B, dt, state spec).
+    measurement : MeasurementModel
+        What is measured.
+    x0 : ndarray, shape (n,)
+        Initial true state.
+    n_steps : int
+        Number of sampling intervals (histories have n_steps + 1 samples).
+    controller : LinearFeedback or None
+        Feedback on the true state (None: zero input).
+    settings : dict
+        The scenario's conditions, normalized (recorded in results).
+    """
+
+    system: object
+    measurement: object
+    x0: np.ndarray
+    n_steps: int
+    controller: object = None
+    settings: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "x0", as_vector("x0", self.x0, self.system.n))
+        object.__setattr__(self, "n_steps", as_int_at_least("n_steps", self.n_steps, 1))
+        if self.measurement.n_state != self.system.n:
+            raise InputError(f"the measurement acts on {self.measurement.n_state} states, the system has {self.system.n}")
+
+    @property
+    def time(self):
+        """Sample times ``t_k = k dt``, s."""
+        return np.arange(self.n_steps + 1) * self.system.dt
+
+
+@dataclass(frozen=True, eq=False)
+class Truth:
+    """Time histories of the true motion.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n_samples,)
+        Time, s.
+    x : ndarray, shape (runs, n_samples, n)
+        True state.
+    u : ndarray, shape (runs, n_samples, m_u)
+        Input applied over [t_k, t_k+1).
+    y : ndarray, shape (runs, n_samples, m)
+        Measurements.
+    settings : dict
+    state : StateSpec
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    settings: dict = field(default_factory=dict)
+    state: object = None
+
+
+def child_rngs(seed, runs):
+    """``runs`` independent generators from ``seed`` (an int ≥ 0, a SeedSequence or a Generator)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer, np.random.SeedSequence, np.random.Generator)):
+        raise InputError(f"seed must be a non-negative integer or a numpy.random.Generator; got {seed!r}")
+    if isinstance(seed, (int, np.integer)) and seed < 0:
+        raise InputError(f"seed must be a non-negative integer; got {seed}")
+    return np.random.default_rng(seed).spawn(runs)
+
+
+def noise_models(noise, measurement_noise=None):
+    """The process- and measurement-noise models (the second defaults to the first)."""
+    w_model = make_noise(noise)
+    v_model = w_model if measurement_noise is None else make_noise(measurement_noise)
+    return w_model, v_model
+
+
+def draw_noise(w_model, v_model, rngs, n_samples, p, q):
+    """w (runs, n_samples, p) and v (runs, n_samples, q), each run from its own generator, w first."""
+    runs = len(rngs)
+    w = np.empty((runs, n_samples, p))
+    v = np.empty((runs, n_samples, q))
+    for r, rng in enumerate(rngs):
+        w[r] = w_model.sample(rng, (n_samples, p))
+        v[r] = v_model.sample(rng, (n_samples, q))
+    return w, v
+
+
+def simulate_truth(model, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, first_run=0):
+    """Simulate the true motion and the measurements of a :class:`TruthModel`.
+
+    Parameters
+    ----------
+    model : TruthModel
+    noise : str or NoiseModel
+        Process noise w (and measurement noise v unless ``measurement_noise``
+        is given); a name from :data:`hinfnav.noise.NOISE_NAMES`.
+    measurement_noise : str or NoiseModel, optional
+    runs : int
+        Number of Monte Carlo runs, ≥ 1.
+    seed : int or numpy.random.Generator
+    first_run : int
+        Index of the first run among the seed's children (to simulate one
+        batch of a larger Monte Carlo set).
+
+    Returns
+    -------
+    Truth
+    """
+    if not isinstance(model, TruthModel):
+        raise InputError(f"model must be a hinfnav TruthModel; got {type(model).__name__}")
+    runs = as_int_at_least("runs", runs, 1)
+    first_run = as_int_at_least("first_run", first_run, 0)
+    w_model, v_model = noise_models(noise, measurement_noise)
+    system, meas = model.system, model.measurement
+    n1 = model.n_steps + 1
+    rngs = child_rngs(seed, first_run + runs)[first_run:]
+    w, v = draw_noise(w_model, v_model, rngs, n1, system.n_noise, meas.n_noise)
+    K = None
+    if model.controller is not None:
+        if model.controller.source != "truth":
+            raise InputError("simulate_truth takes feedback on the true state only; use simulate_closed_loop for u = K x̂")
+        K = model.controller.K
+    Acl = system.transition_matrix(K)
+    x = np.empty((runs, n1, system.n))
+    x[:, 0] = model.x0
+    drive = w @ system.B.T
+    AclT = Acl.T
+    for k in range(n1 - 1):
+        x[:, k + 1] = x[:, k] @ AclT + drive[:, k]
+    u = x @ K.T if K is not None else np.zeros((runs, n1, system.n_input))
+    y = meas.measure(x, v)
+    settings = dict(model.settings)
+    settings.update(
+        noise=w_model.name,
+        measurement_noise=v_model.name,
+        runs=runs,
+        seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
+    )
+    return Truth(t=model.time, x=x, u=u, y=y, settings=settings, state=system.state)

@@ -1,0 +1,53 @@
+"""Systems layer: what is estimated.
+
+State specifications (labels, units, groups, error definition), discrete
+linear dynamics, measurement models, the Hill relative motion of a chaser and
+the norm-bounded uncertain system of Sun et al. (2011).
+"""
+
+from .hill import (
+    delta_A1,
+    hill_matrices,
+    hill_system,
+    measurement_matrix,
+    position_measurement,
+    uncertainty_F,
+    uncertainty_structure,
+)
+from .linear import LinearSystem
+from .measurements import (
+    LinearMeasurement,
+    MeasurementModel,
+    RangeAzimuthElevation,
+    Saturated,
+    as_measurement_model,
+    position_from_range_angles,
+    range_angles,
+    range_angles_jacobian,
+    wrap_angle,
+)
+from .state import StateSpec, chaser_state_spec
+from .uncertain import UncertainSystem
+
+__all__ = [
+    "StateSpec",
+    "chaser_state_spec",
+    "LinearSystem",
+    "MeasurementModel",
+    "LinearMeasurement",
+    "RangeAzimuthElevation",
+    "Saturated",
+    "as_measurement_model",
+    "range_angles",
+    "range_angles_jacobian",
+    "position_from_range_angles",
+    "wrap_angle",
+    "hill_matrices",
+    "hill_system",
+    "delta_A1",
+    "uncertainty_structure",
+    "uncertainty_F",
+    "measurement_matrix",
+    "position_measurement",
+    "UncertainSystem",
+]

@@ -1,0 +1,363 @@
+"""Measurement models, outside the filters.
+
+Each model gives its function h(x), its Jacobian, its noise (matrix D with
+unit-variance white v, so R = D Dᵀ), labels and units, and how to form a
+residual. Models act on batches: ``x`` of shape (..., n).
+
+* :class:`LinearMeasurement` — y = C x + D v, e.g. the indirect position
+  measurement (8) of Sun et al. (2011);
+* :class:`RangeAzimuthElevation` — range ρ, azimuth α, elevation β of the
+  relative position, the direct measurement behind (7), with its Jacobian and
+  its inverse (the indirect position measurement);
+* :class:`Saturated` — wraps a model and clips each channel to
+  [lower, upper], reporting which channels saturated.
+"""
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.validation import as_matrix, as_positive
+
+__all__ = [
+    "MeasurementModel",
+    "LinearMeasurement",
+    "RangeAzimuthElevation",
+    "Saturated",
+    "range_angles",
+    "range_angles_jacobian",
+    "position_from_range_angles",
+    "wrap_angle",
+    "as_measurement_model",
+]
+
+
+class MeasurementModel:
+    """Base class: ``y = h(x) + D v`` with unit-variance white v.
+
+    Attributes
+    ----------
+    n_state : int
+    labels, units : tuple of str
+        One per measurement channel.
+    D : ndarray, shape (m, q)
+        Noise matrix; ``R = D Dᵀ``.
+    linear : bool
+        True when ``h(x) = H x`` (then :attr:`H` is that matrix).
+    """
+
+    linear = False
+    H = None
+
+    def __init__(self, n_state, D, labels, units):
+        self.n_state = int(n_state)
+        self.D = as_matrix("D", D)
+        self.D.setflags(write=False)
+        self.labels = tuple(labels)
+        self.units = tuple(units)
+        if len(self.labels) != self.D.shape[0] or len(self.units) != self.D.shape[0]:
+            raise InputError(f"labels and units must have {self.D.shape[0]} entries (rows of D)")
+
+    @property
+    def n_meas(self):
+        """Number of measurement channels."""
+        return self.D.shape[0]
+
+    @property
+    def n_noise(self):
+        """Number of noise channels (columns of D)."""
+        return self.D.shape[1]
+
+    @property
+    def R(self):
+        """Noise covariance ``D Dᵀ``."""
+        return self.D @ self.D.T
+
+    def function(self, x):
+        """``h(x)`` for a batch ``x`` of shape (..., n), shape (..., m)."""
+        raise NotImplementedError
+
+    def jacobian(self, x):
+        """``∂h/∂x`` at a batch of states, shape (..., m, n)."""
+        raise NotImplementedError
+
+    def residual(self, y, yhat):
+        """``y − ŷ`` (angles wrapped where a model has them)."""
+        return np.asarray(y) - np.asarray(yhat)
+
+    def measure(self, x, v):
+        """Noisy measurements ``h(x) + v Dᵀ`` of a batch; ``v`` of shape (..., q)."""
+        return self.function(x) + np.asarray(v) @ self.D.T
+
+    def check_state(self, x, name="x"):
+        x = np.asarray(x, dtype=float)
+        if x.ndim < 1 or x.shape[-1] != self.n_state:
+            raise InputError(f"{name} must have shape (..., {self.n_state}); got {x.shape}")
+        return x
+
+
+class LinearMeasurement(MeasurementModel):
+    """``y = C x + D v``.
+
+    Parameters
+    ----------
+    C : array_like, shape (m, n)
+    D : array_like, shape (m, q)
+    labels, units : sequence of str, optional
+    """
+
+    linear = True
+
+    def __init__(self, C, D, labels=None, units=None):
+        C = as_matrix("C", C)
+        m = C.shape[0]
+        D = as_matrix("D", D, (m, None))
+        super().__init__(C.shape[1], D, labels or tuple(f"y{i}" for i in range(m)), units or ("",) * m)
+        C.setflags(write=False)
+        self.H = C
+
+    @property
+    def C(self):
+        """The measurement matrix."""
+        return self.H
+
+    def function(self, x):
+        return np.asarray(x) @ self.H.T
+
+    def jacobian(self, x):
+        x = np.asarray(x)
+        return np.broadcast_to(self.H, x.shape[:-1] + self.H.shape)
+
+    def measure(self, x, v):
+        return np.asarray(x) @ self.H.T + np.asarray(v) @ self.D.T
+
+
+# ---------------------------------------------------------------------------
+# range / azimuth / elevation, eq. (7) of Sun et al. (2011)
+# ---------------------------------------------------------------------------
+
+
+def _check_C_bl(C_bl):
+    if C_bl is None:
+        return np.eye(3)
+    C = as_matrix("C_bl", C_bl, (3, 3))
+    if not np.allclose(C @ C.T, np.eye(3), atol=1e-9):
+        raise InputError("C_bl must be a rotation matrix (C_bl C_blᵀ = I); it is not orthogonal")
+    return C
+
+
+def _positions(x):
+    x = np.asarray(x, dtype=float)
+    if x.ndim < 1 or x.shape[-1] < 3:
+        raise InputError(f"x must have shape (..., n) with the position in its first 3 components; got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise InputError("x must contain only finite numbers; it has NaN or inf entries")
+    return x[..., :3]
+
+
+def wrap_angle(angle):
+    """Wrap angles to (−π, π] (angles already inside are returned unchanged)."""
+    angle = np.asarray(angle, dtype=float)
+    inside = (angle > -np.pi) & (angle <= np.pi)
+    return np.where(inside, angle, np.pi - np.mod(np.pi - angle, 2 * np.pi))
+
+
+def range_angles(x, C_bl=None):
+    """Range, azimuth and elevation of a relative position, inverse of (7).
+
+    (7) reads ``(x, y, z)ᵀ = C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)ᵀ``,
+    so with ``p_b = C_bl (x, y, z)ᵀ``: ``ρ = |p_b|``,
+    ``α = atan2(p_b2, p_b1)``, ``β = atan2(−p_b3, √(p_b1² + p_b2²))``.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., n), n ≥ 3
+        States whose first three components are the position, m.
+    C_bl : array_like, shape (3, 3), optional
+        Rotation from the relative (orbital) frame to the sensor frame.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ρ (m), α (rad, in (−π, π]), β (rad, in [−π/2, π/2]).
+    """
+    p = _positions(x) @ _check_C_bl(C_bl).T
+    rho = np.linalg.norm(p, axis=-1)
+    if np.any(rho == 0):
+        raise InputError("x has a zero relative position; range and angles are undefined there")
+    h = np.hypot(p[..., 0], p[..., 1])
+    return np.stack([rho, np.arctan2(p[..., 1], p[..., 0]), np.arctan2(-p[..., 2], h)], axis=-1)
+
+
+def range_angles_jacobian(x, C_bl=None, n_state=None):
+    """Jacobian of :func:`range_angles` with respect to the state, batched.
+
+    Parameters
+    ----------
+    x : array_like, shape (..., n)
+    C_bl : array_like, shape (3, 3), optional
+    n_state : int, optional
+        Number of state columns (default ``x.shape[-1]``); columns beyond the
+        position are zero.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, n)
+
+    Raises
+    ------
+    InputError
+        On the line of sight's singularities (zero range, or the position on
+        the sensor z axis where the azimuth is undefined).
+    """
+    C = _check_C_bl(C_bl)
+    x = np.asarray(x, dtype=float)
+    n = x.shape[-1] if n_state is None else int(n_state)
+    p = _positions(x) @ C.T
+    rho2 = np.sum(p * p, axis=-1)
+    h2 = p[..., 0] ** 2 + p[..., 1] ** 2
+    if np.any(h2 == 0):
+        raise InputError("the position lies on the sensor z axis (or at zero range): the azimuth has no derivative there")
+    rho, h = np.sqrt(rho2), np.sqrt(h2)
+    Jb = np.empty(p.shape[:-1] + (3, 3))
+    Jb[..., 0, :] = p / rho[..., None]
+    Jb[..., 1, 0] = -p[..., 1] / h2
+    Jb[..., 1, 1] = p[..., 0] / h2
+    Jb[..., 1, 2] = 0.0
+    Jb[..., 2, 0] = p[..., 2] * p[..., 0] / (h * rho2)
+    Jb[..., 2, 1] = p[..., 2] * p[..., 1] / (h * rho2)
+    Jb[..., 2, 2] = -h / rho2
+    J = np.zeros(p.shape[:-1] + (3, n))
+    J[..., :3] = Jb @ C
+    return J
+
+
+def position_from_range_angles(m, C_bl=None):
+    """Relative position from range and line-of-sight angles, eq. (7).
+
+    Parameters
+    ----------
+    m : array_like, shape (..., 3)
+        ρ (m), α (rad), β (rad).
+    C_bl : array_like, shape (3, 3), optional
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)``, m.
+    """
+    m = np.asarray(m, dtype=float)
+    if m.ndim < 1 or m.shape[-1] != 3:
+        raise InputError(f"m must have shape (..., 3) (range, azimuth, elevation); got {m.shape}")
+    rho, a, b = m[..., 0], m[..., 1], m[..., 2]
+    pb = np.stack([rho * np.cos(b) * np.cos(a), rho * np.cos(b) * np.sin(a), -rho * np.sin(b)], axis=-1)
+    return pb @ _check_C_bl(C_bl)  # C_bl⁻¹ = C_blᵀ, applied to row vectors
+
+
+class RangeAzimuthElevation(MeasurementModel):
+    """Range ρ, azimuth α, elevation β of the relative position, plus white noise.
+
+    Parameters
+    ----------
+    n_state : int
+        Dimension of the state; its first three components are the position (m).
+    sigma_range : float
+        Range noise standard deviation, m.
+    sigma_angle : float
+        Azimuth and elevation noise standard deviation, rad.
+    C_bl : array_like, shape (3, 3), optional
+        Rotation from the relative frame to the sensor frame (identity).
+    """
+
+    def __init__(self, n_state, sigma_range, sigma_angle, C_bl=None):
+        self.sigma_range = as_positive("sigma_range", sigma_range)
+        self.sigma_angle = as_positive("sigma_angle", sigma_angle)
+        self.C_bl = _check_C_bl(C_bl)
+        super().__init__(
+            n_state, np.diag([self.sigma_range, self.sigma_angle, self.sigma_angle]),
+            ("range", "azimuth", "elevation"), ("m", "rad", "rad"),
+        )
+
+    def function(self, x):
+        return range_angles(self.check_state(x), self.C_bl)
+
+    def jacobian(self, x):
+        return range_angles_jacobian(self.check_state(x), self.C_bl, self.n_state)
+
+    def residual(self, y, yhat):
+        d = np.asarray(y, dtype=float) - np.asarray(yhat, dtype=float)
+        d = d.copy()
+        d[..., 1:] = wrap_angle(d[..., 1:])
+        return d
+
+    def measure(self, x, v):
+        out = self.function(x) + np.asarray(v) @ self.D.T
+        out[..., 1] = wrap_angle(out[..., 1])
+        return out
+
+    def inverse(self, m):
+        """The indirect position measurement: position (m) from (ρ, α, β), eq. (7)."""
+        return position_from_range_angles(m, self.C_bl)
+
+    def position_covariance(self, m):
+        """Covariance ``J R Jᵀ`` of the converted position at (ρ, α, β) (first order), shape (..., 3, 3)."""
+        m = np.asarray(m, dtype=float)
+        rho, a, b = m[..., 0], m[..., 1], m[..., 2]
+        J = np.zeros(m.shape[:-1] + (3, 3))
+        ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+        J[..., 0, :] = np.stack([cb * ca, -rho * cb * sa, -rho * sb * ca], axis=-1)
+        J[..., 1, :] = np.stack([cb * sa, rho * cb * ca, -rho * sb * sa], axis=-1)
+        J[..., 2, :] = np.stack([-sb, np.zeros_like(rho), -rho * cb], axis=-1)
+        Jl = self.C_bl.T @ J
+        return Jl @ self.R @ np.swapaxes(Jl, -1, -2)
+
+
+class Saturated(MeasurementModel):
+    """A measurement model whose channels saturate at [lower, upper].
+
+    ``measure`` returns the clipped reading; :meth:`clip` returns it with a
+    boolean flag per channel (True where the reading sat at a bound).
+
+    Parameters
+    ----------
+    model : MeasurementModel
+    lower, upper : array_like, shape (m,)
+        Channel bounds (``-inf``/``inf`` for a channel that does not saturate).
+    """
+
+    def __init__(self, model, lower, upper):
+        if not isinstance(model, MeasurementModel):
+            raise InputError(f"model must be a MeasurementModel; got {type(model).__name__}")
+        m = model.n_meas
+        lo = np.broadcast_to(np.asarray(lower, dtype=float), (m,)).copy()
+        hi = np.broadcast_to(np.asarray(upper, dtype=float), (m,)).copy()
+        if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo >= hi):
+            raise InputError(f"lower must be < upper in every channel; got lower={lo}, upper={hi}")
+        super().__init__(model.n_state, model.D, model.labels, model.units)
+        self.model, self.lower, self.upper = model, lo, hi
+        self.linear = model.linear
+        self.H = model.H
+
+    def function(self, x):
+        return self.model.function(x)
+
+    def jacobian(self, x):
+        return self.model.jacobian(x)
+
+    def residual(self, y, yhat):
+        return self.model.residual(y, yhat)
+
+    def clip(self, y):
+        """``(clipped y, flags)``: flags True where a channel sat at a bound."""
+        y = np.asarray(y, dtype=float)
+        return np.clip(y, self.lower, self.upper), (y <= self.lower) | (y >= self.upper)
+
+    def measure(self, x, v):
+        return self.clip(self.model.measure(x, v))[0]
+
+
+def as_measurement_model(value, name="measurement"):
+    """Check that ``value`` is a :class:`MeasurementModel`."""
+    if not isinstance(value, MeasurementModel):
+        raise InputError(f"{name} must be a hinfnav MeasurementModel; got {type(value).__name__}")
+    return value
+
