@@ -25,7 +25,7 @@ from .filters import FILTER_NAMES, lti_from_matrices, make_estimator
 from .limits import KalmanLimit, kalman_limit, lti_error_covariance
 from .reproduce import reproduce
 from .scenario import Scenario, paper_scenario
-from .studies import format_robustness_table, pos_vel, robustness_table, simulation_comparison, stationary_std, sweep_result
+from .studies import filter_case_rms, format_robustness_table, pos_vel, robustness_table, simulation_comparison, stationary_std, sweep_result
 from .table1 import Table1, format_table1, table1, table1_rows, write_table1
 
 __all__ = [
@@ -66,6 +66,7 @@ __all__ = [
     "stationary_std",
     "sweep_result",
     "pos_vel",
+    "filter_case_rms",
     "ClosedLoopStudy",
     "closed_loop_study",
     "plot_closed_loop",

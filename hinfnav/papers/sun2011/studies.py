@@ -12,7 +12,7 @@ from ...analysis.observer import observer_form
 from ...core.exceptions import InputError
 from ...core.linalg import spectral_radius
 from ...core.validation import as_choice
-from ...metrics.errors import axes_rms, rms_error, rms_per_run
+from ...metrics.errors import axes_rms, max_error, rms_error, rms_per_run
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth
 from .constants import published_filter
@@ -28,12 +28,43 @@ __all__ = [
     "stationary_std",
     "sweep_result",
     "pos_vel",
+    "filter_case_rms",
 ]
 
 
 def pos_vel(values, state):
     """Split per-component values into (position, velocity) by the state's groups."""
     return state.select(values, "position"), state.select(values, "velocity")
+
+
+def filter_case_rms(scenario, filters, *, maneuvers=(False, True), runs=20, seed=0, noise="gaussian"):
+    """Per-axis RMS and maximum error of registered filters with and without maneuver.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    filters : sequence of str
+        Registered filter names (``"published"``, ``"ekf"`` …).
+    maneuvers : sequence of bool
+    runs, seed, noise
+        As in :func:`hinfnav.simulate`.
+
+    Returns
+    -------
+    list of dict
+        One per (filter, maneuver): ``filter``, ``maneuver``, ``pos_m`` and
+        ``vel_mps`` (per-axis RMS over the scenario's window, pooled over runs),
+        ``max_pos_m``, ``max_vel_mps``.
+    """
+    rows = []
+    for name in filters:
+        for maneuver in maneuvers:
+            res = simulate(scenario, name, maneuver=maneuver, runs=runs, seed=seed, noise=noise)
+            pos, vel = pos_vel(rms_error(res.error, res.t, scenario.rms_window_s), res.state)
+            mpos, mvel = pos_vel(max_error(res.error, res.t, scenario.rms_window_s), res.state)
+            rows.append({"filter": name, "maneuver": bool(maneuver), "pos_m": pos, "vel_mps": vel,
+                         "max_pos_m": mpos, "max_vel_mps": mvel})
+    return rows
 
 
 def sweep_result(sweep, delta_bar):

@@ -1,0 +1,35 @@
+"""``reproduce --seed 0`` gives the numbers it gave before the package was reshaped.
+
+Expected values: ``tests/data/sun2011_summary_seed0_runs100.json``, the
+``summary.json`` written by ``python -m hinfnav reproduce --seed 0`` (100 runs)
+at commit 7c2aec2, before issue 7's restructuring. Tolerance 1e-9 relative
+(issue 7); the comparison is ``benchmarks/compare_summaries.py``.
+"""
+
+import importlib.util
+import json
+from pathlib import Path
+
+from hinfnav.papers import reproduce
+
+ROOT = Path(__file__).resolve().parents[1]
+EXPECTED = ROOT / "tests" / "data" / "sun2011_summary_seed0_runs100.json"
+FILES = ["table1.csv", "table1.md", "summary.json"] + [f"fig{i}.{ext}" for i in range(2, 8) for ext in ("png", "pdf")]
+
+
+def _comparator():
+    spec = importlib.util.spec_from_file_location("compare_summaries", ROOT / "benchmarks" / "compare_summaries.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.compare
+
+
+def test_reproduce_seed0_matches_the_numbers_before_the_reshaping(tmp_path):
+    reproduce("sun2011", tmp_path, seed=0, runs=100, progress=False)
+    for name in FILES:
+        assert (tmp_path / name).is_file() and (tmp_path / name).stat().st_size > 0, name
+    new = json.loads((tmp_path / "summary.json").read_text())
+    old = json.loads(EXPECTED.read_text())
+    problems, worst, n = _comparator()(old, new, 1e-9)
+    assert n > 250
+    assert not problems, "\n".join(problems[:20])
