@@ -12,7 +12,15 @@ The package is layered, each layer importing only those before it:
 The names below are the public API, re-exported from those layers.
 """
 
-from .analysis import h2_norm, hinf_norm, observer_form, steady_state_kalman, worst_case_norm
+from .analysis import (
+    h2_norm,
+    hinf_norm,
+    observer_form,
+    steady_state_hinf,
+    steady_state_kalman,
+    truncated_normal_moments,
+    worst_case_norm,
+)
 from .control import LinearFeedback
 from .core import (
     CertificationError,
@@ -32,6 +40,7 @@ from .estimators import (
     LTIFilter,
     StepOutput,
     build_estimator,
+    huber_update,
     register_estimator,
     registered_estimators,
 )
@@ -98,6 +107,8 @@ __all__ = [
     "worst_case_norm",
     "steady_state_kalman",
     "observer_form",
+    "steady_state_hinf",
+    "truncated_normal_moments",
     # design
     "synthesize",
     "SynthesisResult",
@@ -110,6 +121,7 @@ __all__ = [
     "StepOutput",
     "LTIFilter",
     "ExtendedKalmanFilter",
+    "huber_update",
     "register_estimator",
     "build_estimator",
     "registered_estimators",

@@ -15,8 +15,10 @@ from .norms import (
     hinf_norm_bisection,
     hinf_norm_grid,
 )
+from .hinf_riccati import max_admissible_theta, steady_state_hinf
 from .observer import observer_form
 from .riccati import stationary_lti_error_covariance, steady_state_kalman
+from .truncated import truncated_normal_moments
 
 __all__ = [
     "NORM_TOL",
@@ -39,4 +41,7 @@ __all__ = [
     "stationary_lti_error_covariance",
     "steady_state_kalman",
     "observer_form",
+    "steady_state_hinf",
+    "max_admissible_theta",
+    "truncated_normal_moments",
 ]

@@ -37,7 +37,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_nonnegative, as_positive
 
-__all__ = ["steady_state_hinf", "max_admissible_theta"]
+__all__ = ["max_admissible_theta", "steady_state_hinf"]
 
 _BLOWUP = 1e14  # growth of ||P|| relative to max(||Q||, 1) taken as divergence
 

@@ -5,6 +5,7 @@ matrices.
 """
 
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+from .huber import HuberUpdate, huber_update
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 from .lti import LTIFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -18,6 +19,8 @@ __all__ = [
     "LTIFilter",
     "ExtendedKalmanFilter",
     "OUTPUTS",
+    "huber_update",
+    "HuberUpdate",
     "register_estimator",
     "build_estimator",
     "registered_estimators",
