@@ -6,7 +6,7 @@ certification), for the default solver chain (Clarabel, then CVXOPT polish)
 and for each solver alone; then the time of the whole sweep. Both filter
 forms are run: ``general`` (LMI (20) as in the paper) and ``observer``
 (``C_F = −L``, ``A_F = A + B_F C`` imposed); a last table compares them
-(γ_observer / γ* and the residual of :func:`hinfnav.synthesis.observer_form`).
+(γ_observer / γ* and the residual of :func:`hinfnav.analysis.observer_form`).
 
 Run: ``python benchmarks/bench_synthesis.py [--repeat N] [--form general|observer|both]`` (not a test).
 """
@@ -16,8 +16,8 @@ import time
 
 import numpy as np
 
-from hinfnav.scenario import Scenario
-from hinfnav.synthesis import DEFAULT_DELTA_BARS, gamma_sweep, observer_form
+from hinfnav.analysis import observer_form
+from hinfnav.papers.sun2011 import DEFAULT_DELTA_BARS, Scenario, gamma_sweep
 
 
 def run(solver, repeat, form="general"):
