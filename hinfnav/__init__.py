@@ -10,75 +10,102 @@ The package is layered, each layer importing only those before it:
 ``estimators`` → ``control`` → ``sim`` → ``metrics`` → ``plotting`` →
 ``papers`` → ``cli`` (checked by import-linter, ``pyproject.toml``).
 The names below are the public API, re-exported from those layers.
+
+Names are loaded lazily (PEP 562): ``import hinfnav`` is cheap, and the heavy
+layers (cvxpy, python-control, matplotlib) are imported on first use, so the
+command line starts fast.
 """
 
-from .analysis import (
-    h2_norm,
-    hinf_norm,
-    observer_form,
-    steady_state_hinf,
-    steady_state_kalman,
-    truncated_normal_moments,
-    worst_case_norm,
-)
-from .control import LinearFeedback
-from .core import (
-    CertificationError,
-    HinfnavError,
-    InfeasibleLMIError,
-    InputError,
-    SynthesisError,
-    UnstablePlantError,
-    discretize,
-)
-from .design import SampleSet, SolverOptions, SynthesisResult, synthesize
-from .estimators import (
-    EstimateHistory,
-    Estimator,
-    ExtendedKalmanFilter,
-    FilterState,
-    LTIFilter,
-    StepOutput,
-    build_estimator,
-    huber_update,
-    register_estimator,
-    registered_estimators,
-)
-from .metrics import convergence_time, max_error, monte_carlo_summary, rms_error, rms_per_run
-from .noise import NOISE_NAMES, make_noise
-from .papers.sun2011 import (
-    EKF,
-    FILTER_NAMES,
-    GammaSweep,
-    KalmanLimit,
-    Scenario,
-    build_ekf,
-    compare_with_published,
-    design_for_scenario,
-    design_report,
-    gamma_sweep,
-    infer_sampling_time,
-    kalman_limit,
-    lti_error_covariance,
-    make_estimator,
-    published_filter,
-    range_angle_measurements,
-)
-from .sim import SimulationResult, TruthModel, simulate, simulate_closed_loop, simulate_truth
-from .systems import (
-    LinearMeasurement,
-    LinearSystem,
-    MeasurementModel,
-    RangeAzimuthElevation,
-    Saturated,
-    StateSpec,
-    UncertainSystem,
-    hill_matrices,
-    position_from_range_angles,
-    range_angles,
-    uncertainty_F,
-    uncertainty_structure,
-)
+import importlib
+
+#: Public name -> the module (relative to this package) it comes from.
+_EXPORTS = {
+    "h2_norm": "analysis",
+    "hinf_norm": "analysis",
+    "observer_form": "analysis",
+    "steady_state_hinf": "analysis",
+    "steady_state_kalman": "analysis",
+    "truncated_normal_moments": "analysis",
+    "worst_case_norm": "analysis",
+    "LinearFeedback": "control",
+    "CertificationError": "core",
+    "HinfnavError": "core",
+    "InfeasibleLMIError": "core",
+    "InputError": "core",
+    "SynthesisError": "core",
+    "UnstablePlantError": "core",
+    "discretize": "core",
+    "SampleSet": "design",
+    "SolverOptions": "design",
+    "SynthesisResult": "design",
+    "synthesize": "design",
+    "EstimateHistory": "estimators",
+    "Estimator": "estimators",
+    "ExtendedKalmanFilter": "estimators",
+    "FilterState": "estimators",
+    "LTIFilter": "estimators",
+    "StepOutput": "estimators",
+    "build_estimator": "estimators",
+    "huber_update": "estimators",
+    "register_estimator": "estimators",
+    "registered_estimators": "estimators",
+    "convergence_time": "metrics",
+    "max_error": "metrics",
+    "monte_carlo_summary": "metrics",
+    "rms_error": "metrics",
+    "rms_per_run": "metrics",
+    "NOISE_NAMES": "noise",
+    "make_noise": "noise",
+    "EKF": "papers.sun2011",
+    "FILTER_NAMES": "papers.sun2011",
+    "GammaSweep": "papers.sun2011",
+    "KalmanLimit": "papers.sun2011",
+    "Scenario": "papers.sun2011",
+    "build_ekf": "papers.sun2011",
+    "compare_with_published": "papers.sun2011",
+    "design_for_scenario": "papers.sun2011",
+    "design_report": "papers.sun2011",
+    "gamma_sweep": "papers.sun2011",
+    "infer_sampling_time": "papers.sun2011",
+    "kalman_limit": "papers.sun2011",
+    "load_design": "papers.sun2011",
+    "lti_error_covariance": "papers.sun2011",
+    "make_estimator": "papers.sun2011",
+    "published_filter": "papers.sun2011",
+    "range_angle_measurements": "papers.sun2011",
+    "save_design": "papers.sun2011",
+    "SimulationResult": "sim",
+    "TruthModel": "sim",
+    "simulate": "sim",
+    "simulate_closed_loop": "sim",
+    "simulate_truth": "sim",
+    "LinearMeasurement": "systems",
+    "LinearSystem": "systems",
+    "MeasurementModel": "systems",
+    "RangeAzimuthElevation": "systems",
+    "Saturated": "systems",
+    "StateSpec": "systems",
+    "UncertainSystem": "systems",
+    "hill_matrices": "systems",
+    "position_from_range_angles": "systems",
+    "range_angles": "systems",
+    "uncertainty_F": "systems",
+    "uncertainty_structure": "systems",
+}
+
+
+def __getattr__(name):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'hinfnav' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __version__ = "0.2.0"
 
@@ -155,6 +182,8 @@ __all__ = [
     "GammaSweep",
     "design_report",
     "compare_with_published",
+    "save_design",
+    "load_design",
     # errors
     "HinfnavError",
     "InputError",

@@ -44,9 +44,12 @@ def _check(rng, shape):
     if not isinstance(rng, np.random.Generator):
         raise InputError(f"rng must be a numpy.random.Generator (e.g. numpy.random.default_rng(seed)); got {type(rng).__name__}")
     try:
-        shape = tuple(int(s) for s in shape)
+        items = tuple(shape)
     except TypeError:
         raise InputError(f"shape must be a tuple of non-negative integers; got {shape!r}") from None
+    if any(isinstance(s, bool) or not isinstance(s, (int, np.integer)) for s in items):
+        raise InputError(f"shape must be a tuple of non-negative integers; got {shape!r}")
+    shape = tuple(int(s) for s in items)
     if any(s < 0 for s in shape):
         raise InputError(f"shape must be a tuple of non-negative integers; got {shape!r}")
     return shape

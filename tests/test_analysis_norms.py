@@ -1,34 +1,28 @@
-"""Tests of hinfnav.hinfnorm: H∞ norms, the error system (13)–(15), certificates."""
+"""Tests of hinfnav.analysis (H∞ norms, the error system (13)–(15), certificates) and the robust
+bounded real LMI of hinfnav.lmi."""
 
 import control
 import numpy as np
 import pytest
 
-from hinfnav.exceptions import InputError
-from hinfnav.hinfnorm import (
+from hinfnav.analysis import (
     brl_matrix,
     certify_negative_definite,
     channel_norms,
     error_system,
     error_system_matrices,
     frequency_response_sigma,
+    h2_norm,
     hinf_norm,
     hinf_norm_bisection,
     hinf_norm_grid,
-    robust_bounded_real_lmi,
     schur_gamma,
-    spectral_radius,
     worst_case_norm,
 )
-from hinfnav.models import UncertainSystem
-from hinfnav.scenario import Scenario, published_filter
-
-
-def _random_stable(rng, n, m, p, rho):
-    """A random discrete system with spectral radius rho (built here, not by control.drss)."""
-    A = rng.standard_normal((n, n))
-    A *= rho / spectral_radius(A)
-    return control.ss(A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), np.zeros((p, m)), True)
+from hinfnav.core import InputError, spectral_radius
+from hinfnav.lmi import robust_bounded_real_lmi
+from hinfnav.papers.sun2011 import published_filter
+from hinfnav.systems import UncertainSystem
 
 
 # --------------------------------------------------------------------------- known answers
@@ -72,11 +66,11 @@ def test_unstable_system_has_infinite_norm():
 
 
 @pytest.mark.parametrize("seed", range(6))
-def test_slycot_and_bisection_agree_on_random_systems(seed):
+def test_slycot_and_bisection_agree_on_random_systems(seed, random_stable):
     # two independent algorithms (SLICOT ab13dd; BBBS on the symplectic pencil here)
     # agree to 1e-8; the grid is a lower bound within 1e-3
     rng = np.random.default_rng(seed)
-    sys = _random_stable(rng, n=5, m=2, p=3, rho=rng.uniform(0.5, 0.99))
+    sys = random_stable(rng, n=5, m=2, p=3, rho=rng.uniform(0.5, 0.99))
     g1 = hinf_norm(sys)
     g2 = hinf_norm_bisection(sys)
     g3 = hinf_norm_grid(sys)
@@ -85,14 +79,14 @@ def test_slycot_and_bisection_agree_on_random_systems(seed):
     assert g3 >= g1 * (1 - 1e-3)
 
 
-def test_with_feedthrough():
+def test_with_feedthrough(random_stable):
     # static gain D only: ‖D‖₂ (closed form); plus a dynamic part: agree between methods
     rng = np.random.default_rng(7)
     D = rng.standard_normal((2, 3))
     static = control.ss(np.zeros((1, 1)), np.zeros((1, 3)), np.zeros((2, 1)), D, True)
     assert hinf_norm(static) == pytest.approx(np.linalg.norm(D, 2), rel=1e-9)
     assert hinf_norm_bisection(static) == pytest.approx(np.linalg.norm(D, 2), rel=1e-9)
-    sys = _random_stable(rng, 4, 3, 2, 0.9)
+    sys = random_stable(rng, 4, 3, 2, 0.9)
     sys = control.ss(sys.A, sys.B, sys.C, D, True)
     assert hinf_norm_bisection(sys) == pytest.approx(hinf_norm(sys), rel=1e-8)
 
@@ -104,6 +98,15 @@ def test_frequency_response_matches_transfer_function():
     w = np.array([0.1, 1.0, 3.0])
     expected = np.abs(c * b / (np.exp(1j * w * T) - a))
     np.testing.assert_allclose(frequency_response_sigma(sys, w), expected, rtol=1e-12)
+
+
+def test_h2_norm_first_order_known_answer():
+    # G(z) = c b/(z − a): impulse response c b a^(k−1), k ≥ 1, so ‖G‖₂² = c² b²/(1 − a²) (closed form);
+    # infinite for an unstable system
+    a, b, c = 0.6, 2.0, -1.5
+    sys = control.ss([[a]], [[b]], [[c]], [[0.0]], 0.1)
+    assert h2_norm(sys) == pytest.approx(abs(c * b) / np.sqrt(1 - a * a), rel=1e-12)
+    assert h2_norm(control.ss([[1.01]], [[1.0]], [[1.0]], [[0.0]], True)) == np.inf
 
 
 # --------------------------------------------------------------------------- error system (13)–(15)
@@ -136,10 +139,10 @@ def test_error_system_structure_and_transfer_function():
     assert sys.dt == 0.2
 
 
-def test_published_filter_norm_cross_checked():
+def test_published_filter_norm_cross_checked(scenario):
     # the published filter (Section 4) on the paper's error system at δ = 0: slycot and the
     # independent BBBS iteration agree to 1e-9; the dense grid to 1e-6
-    sc = Scenario()
+    sc = scenario
     s = sc.design_model(0.05)
     pub = published_filter()
     sys = error_system(s.A, s.B, s.C, s.D, s.L, pub.A_F, pub.B_F, pub.C_F, sc.dt)
@@ -202,11 +205,11 @@ def test_certify_negative_definite():
     assert not certify_negative_definite(np.diag([-1.0, -1e-16]))[0]
 
 
-def test_bounded_real_lemma_matches_norm():
+def test_bounded_real_lemma_matches_norm(random_stable):
     # Lemma 1: the smallest γ for which (17) is feasible is the H∞ norm; solver + certificate
     # reproduce the slycot norm to 1e-6
     rng = np.random.default_rng(5)
-    sys = _random_stable(rng, 3, 2, 2, 0.8)
+    sys = random_stable(rng, 3, 2, 2, 0.8)
     cert = robust_bounded_real_lmi(sys.A, sys.B, sys.C)
     g = hinf_norm(sys)
     assert cert.gamma >= g * (1 - 1e-9)

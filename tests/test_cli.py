@@ -20,6 +20,12 @@ def test_help_lists_the_commands():
         assert cmd in out.stdout
 
 
+def test_reproduce_takes_a_paper(capsys):
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    assert "--paper" in capsys.readouterr().out
+
+
 def test_simulate_json_fields():
     out = run_cli("simulate", "--filter", "published", "--json", "--runs", "2", "--seed", "3")
     assert out.returncode == 0, out.stderr
@@ -54,6 +60,7 @@ def test_simulate_table_output(capsys):
         (["simulate", "--delta", "inf"], "--delta must be finite"),
         (["simulate", "--delta", "-3"], "delta must be > -1"),
         (["design", "--delta-bar", "-0.1"], "--delta-bar must be >= 0"),
+        (["reproduce", "--paper", "nope"], "invalid choice: 'nope'"),
     ],
 )
 def test_bad_input_gives_a_clear_message_not_a_traceback(args, message):

@@ -1,4 +1,5 @@
-"""Tests of hinfnav.synthesis: Theorem 1 / Corollary 1, certified."""
+"""Tests of the certified synthesis, Theorem 1 / Corollary 1 (hinfnav.design, hinfnav.lmi),
+and of Sun et al. (2011)'s designs built on it (hinfnav.papers.sun2011.designs)."""
 
 import json
 
@@ -6,43 +7,43 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-import hinfnav.synthesis as synthesis
-from hinfnav.exceptions import (
+import hinfnav.design.robust_hinf as robust_hinf
+from hinfnav.analysis import (
+    error_system,
+    hinf_norm,
+    hinf_norm_bisection,
+    observer_form,
+    schur_gamma,
+    worst_case_norm,
+)
+from hinfnav.core import (
     CertificationError,
     HinfnavError,
     InfeasibleLMIError,
     InputError,
     UnstablePlantError,
 )
-from hinfnav.hinfnorm import (
-    hinf_norm,
-    hinf_norm_bisection,
-    schur_gamma,
-    spectral_radius,
-    worst_case_norm,
-)
-from hinfnav.models import UncertainSystem, hill_matrices, uncertainty_F
-from hinfnav.scenario import Scenario, published_filter
-from hinfnav.synthesis import (
+from hinfnav.design import SampleSet, SolverOptions, synthesize
+from hinfnav.lmi import lmi20_matrix, observer_lmi_matrix, prepare, prepare_uncertainty
+from hinfnav.papers.sun2011 import (
+    GammaSweep,
     compare_with_published,
     delta_grid,
+    delta_samples,
     design_for_scenario,
     design_report,
     format_design_report,
     gamma_sweep,
-    lmi20_matrix,
-    observer_form,
-    observer_lmi_matrix,
-    prepare_uncertainty,
+    published_filter,
     simulation_comparison,
-    synthesize,
 )
+from hinfnav.systems import UncertainSystem, hill_matrices, uncertainty_F
 
 
 @pytest.fixture(scope="module")
-def paper_design():
+def paper_design(scenario):
     """The δ̄ = 0.05 design of the paper's scenario (shared: ~0.6 s)."""
-    return design_for_scenario(Scenario(), 0.05)
+    return design_for_scenario(scenario, 0.05)
 
 
 # --------------------------------------------------------------------------- known answers
@@ -79,23 +80,12 @@ def test_uncertain_scalar_known_answer(a, h, e):
     assert res.verified_norm == pytest.approx(1 / (1 - a - abs(h * e)), rel=1e-6)  # F = +1 is sampled
 
 
-def _random_uncertain(rng, n=3, p=2, m=2, q=2, l=2, r=2, rho=0.8, size=0.1):
-    A = rng.standard_normal((n, n))
-    A *= rho / spectral_radius(A)
-    B, C, D, L = (rng.standard_normal(s) for s in [(n, p), (m, n), (m, q), (l, n)])
-    H = rng.standard_normal((n, r))
-    E = rng.standard_normal((r, n))
-    H *= np.sqrt(size) / np.linalg.norm(H, 2)
-    E *= np.sqrt(size) / np.linalg.norm(E, 2)
-    return A, B, C, D, L, H, E
-
-
 @pytest.mark.parametrize("seed", range(8))
-def test_random_uncertain_systems_are_certified(seed):
+def test_random_uncertain_systems_are_certified(seed, random_uncertain):
     # every returned filter must satisfy Theorem 1's guarantee on F it was never checked at,
     # by an independent norm algorithm; otherwise a named error is acceptable
     rng = np.random.default_rng(seed)
-    A, B, C, D, L, H, E = _random_uncertain(rng, size=[0.02, 0.1, 0.3][seed % 3])
+    A, B, C, D, L, H, E = random_uncertain(rng, size=[0.02, 0.1, 0.3][seed % 3])
     try:
         res = synthesize(A, B, C, D, L, H, E, seed=rng)
     except (InfeasibleLMIError, CertificationError, UnstablePlantError) as exc:
@@ -116,11 +106,11 @@ def test_random_uncertain_systems_are_certified(seed):
     assert hinf_norm(sys0) <= res.gamma
 
 
-def test_lmi20_holds_at_returned_unscaled_variables(paper_design):
+def test_lmi20_holds_at_returned_unscaled_variables(paper_design, scenario):
     # LMI (20) evaluated in float64 with the plant data and the returned variables (original state
     # coordinates, balanced H, E) is negative definite at the returned γ: a solver-free check
     res = paper_design
-    s = Scenario().design_model(0.05)
+    s = scenario.design_model(0.05)
     v = res.variables
     M0 = lmi20_matrix(s.A, s.B, s.C, s.D, s.L, v["H"], v["E"], v["R"], v["S"], v["Abar_F"], v["Bbar_F"], v["Cbar_F"], v["lam"], 0.0)
     n, p, q = 6, 6, 3
@@ -131,16 +121,16 @@ def test_lmi20_holds_at_returned_unscaled_variables(paper_design):
     np.testing.assert_allclose(v["Cbar_F"], res.C_F)
 
 
-def test_state_scaling_is_exact_powers_of_two(paper_design):
+def test_state_scaling_is_exact_powers_of_two(scenario):
     # the internal coordinates x = Σ x̃ use powers of two, so unscaling is exact
-    P = synthesis._prepare(Scenario().design_model(0.05), "diagonal", "balance")
+    P = prepare(scenario.design_model(0.05), "diagonal", "balance")
     assert np.all(np.log2(P.sigma) == np.round(np.log2(P.sigma)))
     assert not np.all(P.sigma == 1)
 
 
-def test_prepare_uncertainty_drops_zero_columns_and_balances():
+def test_prepare_uncertainty_drops_zero_columns_and_balances(scenario):
     # paper's H_a, E_a: columns 1 and 5 of H_a (rows of E_a) are zero (Section 4)
-    s = Scenario().design_model(0.05)
+    s = scenario.design_model(0.05)
     Hb, Eb, (kh, ke) = prepare_uncertainty(s.H, s.E, "diagonal")
     assert list(kh) == [0, 2, 3, 4]
     # H diag(s) F diag(s)⁻¹ E = H F E for diagonal F (identity, to round-off)
@@ -159,7 +149,7 @@ def test_prepare_uncertainty_drops_zero_columns_and_balances():
 # --------------------------------------------------------------------------- the paper's system
 
 
-def test_paper_design_is_certified(paper_design):
+def test_paper_design_is_certified(paper_design, scenario):
     res = paper_design
     assert res.delta_bar == 0.05
     assert 0.05 in res.deltas and -0.05 in res.deltas and 0.0 in res.deltas
@@ -167,8 +157,11 @@ def test_paper_design_is_certified(paper_design):
     assert res.spectral_radius < 1
     # the certified γ and the solver's agree to 1e-4 (rtol of the synthesis)
     assert res.gamma == pytest.approx(res.lmi_gamma, rel=1e-4)
+    # the samples are the δ grid, carried as a SampleSet (labels and δ of each sample)
+    assert res.sample_labels[int(np.argmin(np.abs(res.deltas - 0.05)))] == "δ = 0.05"
+    assert res.worst_delta in res.deltas
     # independent recomputation of the sampled worst case at the vertices (slycot and BBBS)
-    s = Scenario().design_model(0.05)
+    s = scenario.design_model(0.05)
     for d in (-0.05, 0.05):
         sys = res.error_system(s, uncertainty_F(d, 0.05))
         assert hinf_norm_bisection(sys) <= res.gamma
@@ -176,9 +169,9 @@ def test_paper_design_is_certified(paper_design):
     assert ss.dt == 0.1 and ss.nstates == 6
 
 
-def test_solvers_agree_and_gamma_nondecreasing(paper_design):
+def test_solvers_agree_and_gamma_nondecreasing(paper_design, scenario):
     # Clarabel alone vs the default (Clarabel, CVXOPT polish): same optimum to 1e-4
-    sc = Scenario()
+    sc = scenario
     clar = design_for_scenario(sc, 0.05, solver="CLARABEL")
     assert clar.gamma == pytest.approx(paper_design.gamma, rel=1e-4)
     assert clar.solver == "CLARABEL"
@@ -208,15 +201,13 @@ def test_design_report_is_json_ready():
     assert "filter form        : general" in txt
 
 
-def test_compare_with_published(paper_design):
+def test_compare_with_published(paper_design, scenario):
     cmp = compare_with_published(design=paper_design)
     pub, opt = cmp["published"], cmp["optimal"]
     # the published filter's norm, recomputed independently (BBBS on its nominal error system)
-    sc = Scenario()
+    sc = scenario
     s = sc.design_model(0.05)
     pf = published_filter()
-    from hinfnav.hinfnorm import error_system
-
     g_pub = hinf_norm_bisection(error_system(s.A, s.B, s.C, s.D, s.L, pf.A_F, pf.B_F, pf.C_F, sc.dt))
     assert pub["nominal_norm"] == pytest.approx(g_pub, rel=1e-8)
     # the robust bound (all F) is never below the sampled worst case
@@ -245,6 +236,13 @@ def test_delta_grid_contains_vertices_and_zero():
     g = delta_grid(0.2, 4)
     assert g[0] == -0.2 and g[-1] == 0.2 and 0.0 in g
     assert list(delta_grid(0.0)) == [0.0]
+    # as a SampleSet: F_Δa(δ) at each δ of the grid, labelled, with δ̄ as the bound
+    ss = delta_samples(0.2, 4)
+    assert isinstance(ss, SampleSet) and len(ss) == g.size and ss.bound == 0.2
+    np.testing.assert_array_equal(ss.values, g)
+    for d, F in zip(g, ss.matrices):
+        np.testing.assert_array_equal(F, uncertainty_F(d, 0.2))
+    assert delta_samples(0.0) is None
 
 
 # --------------------------------------------------------------------------- bad input
@@ -284,9 +282,9 @@ def test_h_without_e_and_bad_options():
         synthesize(*args, H=np.eye(2) * 0.1, E=np.eye(2) * 0.1, structure="diagonal", uncertainty_samples=[[[0.5, 0.5], [0, 0]]])
 
 
-def test_no_maneuver_hill_model_is_rejected_with_explanation():
+def test_no_maneuver_hill_model_is_rejected_with_explanation(scenario):
     # the unforced Hill model (A = I + T A₁) has spectral radius ≥ 1: Lemma 1 cannot hold
-    sc = Scenario()
+    sc = scenario
     A1, _ = hill_matrices(sc.omega0, sc.mass)
     A = np.eye(6) + sc.dt * A1
     s = sc.design_model(0.0)
@@ -313,57 +311,76 @@ def test_infeasible_lmi_carries_solver_status():
 def test_certification_failure_is_reported(monkeypatch):
     # if no solution survives the checks, CertificationError says why
     def refuse(P, sol, system, samples, dt):
-        return synthesis._Check(False, "forced refusal for the test")
+        return robust_hinf._Check(False, "forced refusal for the test")
 
-    monkeypatch.setattr(synthesis, "_rebuild_and_certify", refuse)
+    monkeypatch.setattr(robust_hinf, "_rebuild_and_certify", refuse)
     with pytest.raises(CertificationError, match="forced refusal"):
-        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], method="minimize")
+        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], options=SolverOptions(method="minimize"))
+
+
+def test_solver_options():
+    # every solver choice in one object; solver= is a shorthand for SolverOptions.only(solver)
+    assert SolverOptions().solvers == ("CLARABEL", "CVXOPT")
+    assert SolverOptions.only("clarabel").solvers == ("CLARABEL",)
+    assert SolverOptions(solvers="cvxopt").solvers == ("CVXOPT",)
+    res = synthesize([[0.5]], [[1.0]], [[0.0]], [[1.0]], [[1.0]], options=SolverOptions.only("CLARABEL", method="minimize"))
+    assert res.solver == "CLARABEL" and res.method == "minimize"
+    args = ([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]])
+    with pytest.raises(InputError, match="not both"):
+        synthesize(*args, solver="CLARABEL", options=SolverOptions())
+    with pytest.raises(InputError, match="options must be a hinfnav.SolverOptions"):
+        synthesize(*args, options={"method": "minimize"})
+    with pytest.raises(InputError, match="unknown method 'newton'"):
+        SolverOptions(method="newton")
+    with pytest.raises(InputError, match="rtol must be > 0"):
+        SolverOptions(rtol=0.0)
+    with pytest.raises(TypeError, match="method"):
+        synthesize(*args, method="minimize")
 
 
 def test_errors_share_the_base_class():
     assert issubclass(InfeasibleLMIError, HinfnavError) and issubclass(CertificationError, HinfnavError)
 
 
-def test_plots_return_artists_and_label_axes(paper_design):
+def test_plots_return_artists_and_label_axes(paper_design, scenario):
     # object API only: a bare Figure, no pyplot state
     from matplotlib.figure import Figure
 
-    from hinfnav import synthesis_plots
-    from hinfnav.synthesis import GammaSweep
+    from hinfnav import plotting
 
     fig = Figure()
     axes = fig.subplots(2, 3)
     sweep = GammaSweep(np.array([0.05]), (paper_design,))
-    system = Scenario().design_model(0.05)
-    assert synthesis_plots.plot_gamma_curve(sweep, ax=axes[0, 0])
+    system = scenario.design_model(0.05)
+    assert plotting.plot_gamma_curve(sweep, ax=axes[0, 0])
     assert "δ̄" in axes[0, 0].get_xlabel()
-    arts = synthesis_plots.plot_sigma(paper_design.error_system(system), ax=axes[0, 1], gamma=paper_design.gamma, label="x")
+    arts = plotting.plot_sigma(paper_design.error_system(system), ax=axes[0, 1], gamma=paper_design.gamma, label="x")
     assert len(arts) >= 3 and "rad/s" in axes[0, 1].get_xlabel()
-    assert synthesis_plots.plot_worst_case_over_delta(paper_design, ax=axes[0, 2])
-    imgs = synthesis_plots.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1])
+    assert plotting.plot_worst_case_over_delta(paper_design, ax=axes[0, 2])
+    imgs = plotting.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1])
     assert len(imgs) == 6
     with pytest.raises(InputError, match="axes"):
-        synthesis_plots.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1, :2])
+        plotting.plot_filter_matrices(paper_design.A_F, paper_design.B_F, paper_design.C_F, axes=axes[1, :2])
 
 
 # --------------------------------------------------------------------------- observer form
 
 
 @pytest.fixture(scope="module")
-def observer_design():
+def observer_design(scenario):
     """The δ̄ = 0.05 observer-form design of the paper's scenario (~0.4 s)."""
-    return design_for_scenario(Scenario(), 0.05, form="observer")
+    return design_for_scenario(scenario, 0.05, form="observer")
 
 
 def _rel(M, scale):
     return float(np.max(np.abs(M)) / np.max(np.abs(scale)))
 
 
-def test_observer_form_structure_holds_to_round_off(observer_design):
+def test_observer_form_structure_holds_to_round_off(observer_design, scenario):
     # the constraints C̄_F = −L, Ā_F = S A + B̄_F C are imposed in the scaled coordinates; after unscaling the
     # returned filter must satisfy C_F = −L and A_F = A + B_F C (derivation in synthesize's Notes) to round-off
     res = observer_design
-    s = Scenario().design_model(0.05)
+    s = scenario.design_model(0.05)
     assert res.form == "observer"
     assert _rel(res.C_F + s.L, s.L) < 1e-9
     assert _rel(res.A_F - (s.A + res.B_F @ s.C), res.A_F) < 1e-9
@@ -385,9 +402,9 @@ def test_observer_form_structure_holds_to_round_off(observer_design):
     assert res.gamma == pytest.approx(0.358738, rel=1e-4)
 
 
-def test_general_optimum_is_not_in_observer_form(paper_design):
+def test_general_optimum_is_not_in_observer_form(paper_design, scenario):
     # the reason for the option: the LMI optimum has an observer residual of ~2e-2 (notebook 03, §2)
-    s = Scenario().design_model(0.05)
+    s = scenario.design_model(0.05)
     assert paper_design.form == "general"
     assert observer_form(paper_design.A_F, paper_design.B_F, paper_design.C_F, s.A, s.C)["residual"] > 1e-3
 
@@ -411,11 +428,11 @@ def test_observer_lmi_is_congruent_to_lmi20(uncertain):
     np.testing.assert_allclose(T.T @ M @ T, M_xe, atol=1e-12 * np.max(np.abs(M)))
 
 
-def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_design, observer_design):
+def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_design, observer_design, scenario):
     # a restriction of (20) cannot lower the optimum: γ_observer ≥ γ* (tolerance 1e-6, the solvers' ~1e-7);
     # at δ̄ = 0 they coincide (the central H∞ filter of the nominal problem is an observer; measured 0.3585923
     # vs 0.3585922), at δ̄ = 1 the restriction costs 0.5 % (measured 0.361529 vs 0.359641)
-    sc = Scenario()
+    sc = scenario
     general = gamma_sweep([0.0, 1.0], sc)
     observer = gamma_sweep([0.0, 1.0], sc, form="observer")
     assert all(r.form == "observer" for r in observer.results)
@@ -431,11 +448,11 @@ def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_desig
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_observer_form_on_random_uncertain_systems(seed):
+def test_observer_form_on_random_uncertain_systems(seed, random_uncertain):
     # random data with square L: the structure holds exactly, the result is certified on fresh F, and the
     # restriction never beats the general optimum
     rng = np.random.default_rng(100 + seed)
-    A, B, C, D, L, H, E = _random_uncertain(rng, l=3, size=0.05)
+    A, B, C, D, L, H, E = random_uncertain(rng, l=3, size=0.05)
     try:
         gen = synthesize(A, B, C, D, L, H, E, seed=1)
         obs = synthesize(A, B, C, D, L, H, E, seed=1, form="observer")
@@ -450,13 +467,13 @@ def test_observer_form_on_random_uncertain_systems(seed):
     assert wc.stable and wc.norm <= obs.gamma
 
 
-def test_observer_form_error_does_not_depend_on_the_trajectory(paper_design, observer_design):
+def test_observer_form_error_does_not_depend_on_the_trajectory(paper_design, observer_design, scenario):
     # Monte Carlo (10 runs, paper's initial state, window 100–1000 s): with maneuver the observer-form filter
     # reaches its noise-only stationary std (measured 0.085 m / 0.014 m/s), the general optimum does not
     # (transient of the plant state: velocity ~0.4 m/s); without maneuver (told u = 0) the general optimum's
     # velocity error is ~10–22 m/s, the observer's stays below 0.05 m/s (stationary 0.024 m/s of
     # e⁺ = (I + T A₁ − G C) e + …, plus the decay of the initial 30–40 m estimate error)
-    rows = simulation_comparison(paper_design, Scenario(), runs=10, seed=0, observer=observer_design, starts=("paper",))
+    rows = simulation_comparison(paper_design, scenario, runs=10, seed=0, observer=observer_design, starts=("paper",))
     get = {(r["maneuver"], r["filter"]): r for r in rows}
     assert {f for _, f in get} == {"published", "re-synthesized", "observer form"}
     obs_m = get[True, "observer form"]
@@ -480,7 +497,7 @@ def test_observer_design_report_and_infeasibility():
         synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], uncertainty_samples=[[[0.0]]], form="observer")
 
 
-def test_bad_form_and_non_square_L_are_rejected():
+def test_bad_form_and_non_square_L_are_rejected(scenario):
     args = (np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)))
     with pytest.raises(InputError, match="form"):
         synthesize(*args, np.eye(2), form="luenberger")
@@ -491,4 +508,4 @@ def test_bad_form_and_non_square_L_are_rejected():
     with pytest.raises(InputError, match=r"form='observer'.*L is singular"):
         synthesize(*args, np.ones((2, 2)), form="observer")
     with pytest.raises(InputError, match="form"):
-        design_for_scenario(Scenario(), 0.05, form="Observer")
+        design_for_scenario(scenario, 0.05, form="Observer")

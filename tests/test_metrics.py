@@ -4,6 +4,10 @@ import numpy as np
 import pytest
 
 from hinfnav import InputError, convergence_time, max_error, monte_carlo_summary, rms_error, rms_per_run
+from hinfnav.metrics import by_group, group_rms
+from hinfnav.systems import chaser_state_spec
+
+STATE = chaser_state_spec()
 
 
 def test_rms_of_constant_and_sine():
@@ -11,7 +15,9 @@ def test_rms_of_constant_and_sine():
     e = np.zeros((1, t.size, 6))
     e[0, :, 0] = 2.0  # RMS 2
     e[0, :, 4] = np.sin(2 * np.pi * t)  # RMS 1/√2 over whole periods
-    pos, vel = rms_error(e, t, (0.0, 10.0))
+    rms = rms_error(e, t, (0.0, 10.0))
+    assert rms.shape == (6,)
+    pos, vel = STATE.select(rms, "position"), STATE.select(rms, "velocity")
     assert pos[0] == pytest.approx(2.0)
     assert vel[1] == pytest.approx(1 / np.sqrt(2), rel=1e-3)
     assert max_error(e, t, (0, 10))[0] == 2.0
@@ -24,7 +30,7 @@ def test_window_selects_samples():
     e[1, :, 1] += 1.0
     per = rms_per_run(e, t, (5, 10))
     np.testing.assert_allclose(per[:, 1], [3.0, 4.0])
-    pos, _ = rms_error(e, t, (5, 10))
+    pos = STATE.select(rms_error(e, t, (5, 10)), "position")
     assert pos[1] == pytest.approx(np.sqrt((9 + 16) / 2))
 
 
@@ -45,18 +51,38 @@ def test_convergence_time():
     e = np.zeros((2, 10, 6))
     e[0, :4, 0] = 5.0  # outside until t = 3, settled from t = 4
     e[1, -1, 3] = 9.0  # leaves at the end: never settles
-    np.testing.assert_array_equal(convergence_time(e, t, pos_tol=1.0, vel_tol=1.0), [4.0, np.nan])
+    np.testing.assert_array_equal(convergence_time(e, t, tol=np.ones(6)), [4.0, np.nan])
+    np.testing.assert_array_equal(convergence_time(e, t, tol=1.0), [4.0, np.nan])
+    # a per-component tolerance: 5.0 on x is inside a tolerance of 5 (settled from the start)
+    np.testing.assert_array_equal(convergence_time(e, t, tol=[5.0, 1, 1, 1, 1, 1]), [0.0, np.nan])
 
 
 def test_bad_input():
     t = np.arange(5.0)
+    # any state dimension is accepted, and (n_samples, n) is one run; a 1-D or 4-D error is not
     with pytest.raises(InputError, match="error must have shape"):
-        rms_error(np.zeros((5, 4)), t, (0, 4))
+        rms_error(np.zeros(5), t, (0, 4))
+    with pytest.raises(InputError, match="error must have shape"):
+        rms_error(np.zeros((1, 5, 6, 1)), t, (0, 4))
+    np.testing.assert_array_equal(rms_error(np.ones((5, 4)), t, (0, 4)), np.ones(4))
     with pytest.raises(InputError, match="t must have shape"):
         rms_error(np.zeros((1, 5, 6)), np.arange(4.0), (0, 4))
     with pytest.raises(InputError, match="holds no sample"):
         rms_error(np.zeros((1, 5, 6)), t, (10, 20))
     with pytest.raises(InputError, match="start < end"):
         rms_error(np.zeros((1, 5, 6)), t, (3, 1))
-    with pytest.raises(InputError, match="pos_tol must be > 0"):
-        convergence_time(np.zeros((1, 5, 6)), t, pos_tol=0)
+    with pytest.raises(InputError, match="tol must be finite and > 0"):
+        convergence_time(np.zeros((1, 5, 6)), t, tol=0)
+    with pytest.raises(InputError, match="tol must be finite and > 0"):
+        convergence_time(np.zeros((1, 5, 6)), t, tol=[1, 1, 1, 1, 1, -1])
+
+
+def test_groups_split_by_the_state_spec():
+    # group_rms: sqrt(mean(v²)) over a group's components, by hand: sqrt((1 + 4 + 4)/3) = sqrt(3)
+    v = np.array([1.0, 2.0, 2.0, 0.1, 0.2, 0.3])
+    groups = by_group(v, STATE)
+    np.testing.assert_array_equal(groups["position"], [1.0, 2.0, 2.0])
+    np.testing.assert_array_equal(groups["velocity"], [0.1, 0.2, 0.3])
+    assert group_rms(v, STATE, "position") == pytest.approx(np.sqrt(3.0), rel=1e-15)
+    with pytest.raises(InputError, match="unknown state group 'attitude'"):
+        STATE.select(v, "attitude")

@@ -5,12 +5,9 @@ import pytest
 import scipy.linalg
 
 from hinfnav import InputError, LTIFilter, Scenario, make_estimator, published_filter, rms_error, simulate
-from hinfnav.models import measurement_matrix
-from hinfnav.simulation import simulate_truth
-
-
-def short(**kw):
-    return Scenario(duration_s=60.0, rms_window_s=(10.0, 60.0), **kw)
+from hinfnav.papers.sun2011 import pos_vel
+from hinfnav.sim import simulate_truth
+from hinfnav.systems import measurement_matrix
 
 
 def stationary_error_std(A_F, B_F, C_F, s):
@@ -25,24 +22,24 @@ def stationary_error_std(A_F, B_F, C_F, s):
     return np.sqrt(np.diag(Cbar @ X @ Cbar.T))
 
 
-def test_stationary_std_of_published_filter():
+def test_stationary_std_of_published_filter(scenario):
     # Lyapunov on the error system: 0.177 m and 0.80 m/s per axis; the paper's
     # Table 1 H∞ column is 0.2 m and 0.8 m/s (one significant digit)
     pub = published_filter()
-    std = stationary_error_std(pub.A_F, pub.B_F, pub.C_F, Scenario())
+    std = stationary_error_std(pub.A_F, pub.B_F, pub.C_F, scenario)
     np.testing.assert_allclose(std[:3], [0.1768, 0.1763, 0.1761], atol=5e-4)
     np.testing.assert_allclose(std[3:], [0.808, 0.803, 0.801], atol=2e-3)
 
 
 @pytest.mark.parametrize("maneuver", [False, True])
-def test_published_filter_reproduces_table1_hinf_column(maneuver):
+def test_published_filter_reproduces_table1_hinf_column(maneuver, scenario):
     # paper, Table 1, H∞ column: position 0.2 m, velocity 0.8 m/s with and without maneuver.
     # One significant digit: accept [0.15, 0.25) m and [0.75, 0.85) m/s on every axis.
     # Independent value: the Lyapunov std above (0.177 m, 0.80 m/s); 20 runs x 9000 samples
     # put the Monte Carlo RMS within 2 % of it.
-    s = Scenario()
+    s = scenario
     res = simulate(s, "published", maneuver=maneuver, runs=20, seed=11)
-    pos, vel = rms_error(res.error, res.t, s.rms_window_s)
+    pos, vel = pos_vel(rms_error(res.error, res.t, s.rms_window_s), res.state)
     assert np.all((pos >= 0.15) & (pos < 0.25)), pos
     assert np.all((vel >= 0.75) & (vel < 0.85)), vel
     pub = published_filter()
@@ -50,21 +47,21 @@ def test_published_filter_reproduces_table1_hinf_column(maneuver):
     np.testing.assert_allclose(np.r_[pos, vel], std, rtol=0.02)
 
 
-def test_published_filter_without_input_is_biased_without_maneuver():
+def test_published_filter_without_input_is_biased_without_maneuver(scenario):
     # run exactly as (12) (assuming u = Kx) on a plant with u = 0, the filter's model misses
     # T·G₀K·x: a steady velocity bias ≈ 1.61·T·|K₃₃/m|·z/0.616 ≈ 0.6 m/s on z at z ≈ 1000 m
     # (hand estimate from the filter's DC gain); the velocity RMS grows above 0.85 m/s on z
-    s = Scenario()
+    s = scenario
     res = simulate(s, "published_closed_loop", maneuver=False, runs=5, seed=2)
-    _, vel = rms_error(res.error, res.t, s.rms_window_s)
+    _, vel = pos_vel(rms_error(res.error, res.t, s.rms_window_s), res.state)
     assert vel[2] > 0.9
     res2 = simulate(s, "published_closed_loop", maneuver=True, runs=5, seed=2)
-    _, vel2 = rms_error(res2.error, res2.t, s.rms_window_s)
+    _, vel2 = pos_vel(rms_error(res2.error, res2.t, s.rms_window_s), res2.state)
     assert np.all(vel2 < 0.85)
 
 
-def test_same_seed_identical_arrays_and_different_seed_differs():
-    s = short()
+def test_same_seed_identical_arrays_and_different_seed_differs(short_scenario):
+    s = short_scenario
     a = simulate(s, "published", runs=3, seed=42, noise="mixture")
     b = simulate(s, "published", runs=3, seed=42, noise="mixture")
     c = simulate(s, "published", runs=3, seed=43, noise="mixture")
@@ -73,18 +70,18 @@ def test_same_seed_identical_arrays_and_different_seed_differs():
     assert not np.array_equal(a.x, c.x)
 
 
-def test_generator_seed_is_deterministic():
-    s = short()
+def test_generator_seed_is_deterministic(short_scenario):
+    s = short_scenario
     a = simulate(s, "published", runs=4, seed=np.random.default_rng(9), batch_size=3)
     b = simulate(s, "published", runs=4, seed=np.random.default_rng(9), batch_size=1)
     # same noise streams; batched matrix products differ from per-run ones at round-off only
     np.testing.assert_allclose(a.x, b.x, rtol=1e-12, atol=1e-9)
 
 
-def test_vectorized_monte_carlo_equals_loop():
+def test_vectorized_monte_carlo_equals_loop(short_scenario):
     # batch of 6 runs at once vs one run per batch: same noise streams by construction,
     # the arithmetic differs only in BLAS blocking
-    s = short()
+    s = short_scenario
     vec = simulate(s, "published", runs=6, seed=5, noise="colored", batch_size=6)
     loop = simulate(s, "published", runs=6, seed=5, noise="colored", batch_size=1)
     np.testing.assert_allclose(vec.x, loop.x, rtol=1e-12, atol=1e-9)
@@ -96,11 +93,11 @@ def test_vectorized_monte_carlo_equals_loop():
         np.testing.assert_allclose(one.xhat[0], vec.xhat[r], rtol=1e-12, atol=1e-9)
 
 
-def test_lti_filter_recursion_by_hand():
+def test_lti_filter_recursion_by_hand(short_scenario):
     # three steps of (12) written out
-    s = short()
+    s = short_scenario
     pub = published_filter()
-    f = LTIFilter(pub.A_F, pub.B_F, pub.C_F, dt=s.dt)
+    f = LTIFilter(pub.A_F, pub.B_F, pub.C_F, s.system(), s.measurement)
     y = np.random.default_rng(0).normal(size=(1, 4, 3))
     h = f.estimate(y, np.zeros((1, 4, 3)), s.xhat0)
     xf = np.linalg.solve(pub.C_F, s.xhat0)
@@ -117,31 +114,31 @@ def test_known_input_filter_is_exact_without_noise():
     A = s.design_model().A
     G = np.vstack([1.5 * np.eye(3), 5.0 * np.eye(3)])
     # observer x̂⁺ = (A − GC) x̂ + G y written in x_f = −x̂ coordinates: A_F = A − GC, B_F = −G, C_F = −I
-    f = LTIFilter(A - G @ C, -G, -np.eye(6), dt=s.dt, input_matrix=s.input_matrix_design(), K=s.K)
+    f = LTIFilter(A - G @ C, -G, -np.eye(6), s.system(), s.measurement, input_matrix=s.input_matrix_design(), K=s.K)
     for maneuver in (False, True):
         res = simulate(s, f, maneuver=maneuver, discretization="euler")
         assert np.max(np.abs(res.error[0, -100:])) < 1e-8
 
 
-def test_thrust_is_K_times_state():
-    s = short()
-    t = simulate_truth(s, maneuver=True, runs=2, seed=1)
+def test_thrust_is_K_times_state(short_scenario):
+    s = short_scenario
+    t = simulate_truth(s.truth_model(maneuver=True), runs=2, seed=1)
     np.testing.assert_allclose(t.u, t.x @ s.K.T, rtol=1e-14)
-    t0 = simulate_truth(s, maneuver=False, runs=1, seed=1)
+    t0 = simulate_truth(s.truth_model(maneuver=False), runs=1, seed=1)
     assert np.all(t0.u == 0)
     # initial thrust K x0 (hand computation from the paper's K and x0): Fx ≈ -1364 N
     assert t.u[0, 0, 0] == pytest.approx(s.K[0] @ s.x0, rel=1e-14)
     assert t.u[0, 0, 0] == pytest.approx(-1364.4, abs=0.1)
 
 
-def test_noise_free_truth_is_the_sampled_data_closed_loop():
+def test_noise_free_truth_is_the_sampled_data_closed_loop(make_short_scenario):
     # with B = 0 the truth is the zero-order-hold closed loop x(k+1) = (Φ + ΓK) x(k);
     # independent discretization: scipy.signal.cont2discrete (method "zoh").
     # It stays within 1 % of continuous feedback expm((A₁+G₀K)t) x0 at 60 s.
     import scipy.signal
 
-    s = short(B=np.zeros((6, 6)))
-    t = simulate_truth(s, maneuver=True, runs=1, seed=0)
+    s = make_short_scenario(B=np.zeros((6, 6)))
+    t = simulate_truth(s.truth_model(maneuver=True), runs=1, seed=0)
     A1, G0 = s.continuous_matrices()
     Phi, Gam, *_ = scipy.signal.cont2discrete((A1, G0, np.eye(6), np.zeros((6, 3))), s.dt, method="zoh")
     x_end = np.linalg.matrix_power(Phi + Gam @ s.K, s.n_steps) @ s.x0
@@ -163,37 +160,40 @@ def test_noise_free_truth_is_the_sampled_data_closed_loop():
         ({"maneuver": "yes"}, "maneuver must be True or False"),
     ],
 )
-def test_simulate_bad_input(kwargs, message):
+def test_simulate_bad_input(kwargs, message, short_scenario):
     with pytest.raises(InputError, match=message):
-        simulate(short(), "published", **kwargs)
+        simulate(short_scenario, "published", **kwargs)
 
 
-def test_unknown_filter_name():
+def test_unknown_filter_name(short_scenario):
     with pytest.raises(InputError, match="unknown filter 'kalman'; choose one of: published"):
-        simulate(short(), "kalman")
+        simulate(short_scenario, "kalman")
 
 
-def test_lti_filter_bad_input():
+def test_lti_filter_bad_input(short_scenario):
     pub = published_filter()
-    with pytest.raises(InputError, match="B_F must have shape 6xany"):
-        LTIFilter(pub.A_F, np.ones((5, 3)), pub.C_F, dt=0.1)
+    system, meas = short_scenario.system(), short_scenario.measurement
+    with pytest.raises(InputError, match="B_F must have shape 6x3"):
+        LTIFilter(pub.A_F, np.ones((5, 3)), pub.C_F, system, meas)
     with pytest.raises(InputError, match="C_F must be invertible"):
-        LTIFilter(pub.A_F, pub.B_F, np.zeros((6, 6)), dt=0.1)
+        LTIFilter(pub.A_F, pub.B_F, np.zeros((6, 6)), system, meas)
     with pytest.raises(InputError, match="input_matrix and K must be given together"):
-        LTIFilter(pub.A_F, pub.B_F, pub.C_F, dt=0.1, K=np.ones((3, 6)))
-    f = LTIFilter(pub.A_F, pub.B_F, pub.C_F, dt=0.1)
+        LTIFilter(pub.A_F, pub.B_F, pub.C_F, system, meas, K=np.ones((3, 6)))
+    with pytest.raises(InputError, match="system must be a hinfnav system"):
+        LTIFilter(pub.A_F, pub.B_F, pub.C_F, 0.1, meas)
+    f = LTIFilter(pub.A_F, pub.B_F, pub.C_F, system, meas)
     with pytest.raises(InputError, match="y must have shape"):
         f.estimate(np.ones((5, 3)), np.ones((5, 3)), np.zeros(6))
     with pytest.raises(InputError, match="xhat0 must have 6 entries"):
         f.estimate(np.ones((1, 5, 3)), np.ones((1, 5, 3)), np.zeros(3))
-    with pytest.raises(InputError, match="y must contain only finite"):
+    with pytest.raises(InputError, match=r"y \(the measurements\) must contain only finite"):
         f.estimate(np.full((1, 5, 3), np.nan), np.ones((1, 5, 3)), np.zeros(6))
 
 
-def test_shared_covariance_stays_a_view_across_batches():
+def test_shared_covariance_stays_a_view_across_batches(short_scenario):
     # the EKF's covariance with the linear measurement does not depend on the data; joined
     # over batches it must stay one shared array (stride 0), equal to the single-batch result
-    s = short()
+    s = short_scenario
     a = simulate(s, "ekf", runs=5, seed=3, batch_size=2)
     b = simulate(s, "ekf", runs=5, seed=3, batch_size=5)
     assert a.P.shape == (5, s.n_steps + 1, 6, 6) and a.P.strides[0] == 0

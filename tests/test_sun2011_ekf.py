@@ -1,26 +1,24 @@
-"""Tests of the EKF baseline (hinfnav.ekf), issue 4 item 1."""
+"""Tests of the EKF baseline (hinfnav.papers.sun2011.ekf on hinfnav.estimators.ExtendedKalmanFilter), issue 4 item 1."""
 
 import numpy as np
 import pytest
+from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
 
-from hinfnav.ekf import (
-    DEFAULT_P0_STD,
+from hinfnav.core import InputError
+from hinfnav.estimators import ExtendedKalmanFilter
+from hinfnav.metrics import rms_error
+from hinfnav.papers.sun2011 import (
     EKF,
+    Scenario,
     build_ekf,
-    position_from_range_angles,
+    kalman_limit,
+    make_estimator,
+    pos_vel,
     range_angle_measurements,
-    range_angles,
-    range_angles_jacobian,
 )
-from hinfnav.exceptions import InputError
-from hinfnav.filters import make_estimator
-from hinfnav.kalman import kalman_limit
-from hinfnav.metrics import rms_error, rms_per_run
-from hinfnav.scenario import Scenario
-from hinfnav.simulation import simulate, simulate_truth
-
-SCENARIO = Scenario()
-SHORT = Scenario(duration_s=60.0, rms_window_s=(10.0, 60.0))
+from hinfnav.papers.sun2011.constants import DEFAULT_P0_STD
+from hinfnav.sim import simulate, simulate_truth
+from hinfnav.systems import position_from_range_angles, range_angles, range_angles_jacobian
 
 
 def _rot(a, b, c):
@@ -32,41 +30,55 @@ def _rot(a, b, c):
     return Rz @ Ry @ Rx
 
 
+def filterpy_reference(ekf, y, u, xhat0):
+    """The same EKF run through filterpy's ``ExtendedKalmanFilter``, one run at a time.
+
+    Returns the estimates and covariances the EKF reports, (runs, n_samples, 6) and
+    (runs, n_samples, 6, 6): x̂(k|k), P(k|k) for ``output="filtered"``, the priors otherwise.
+    """
+    runs, n1, _ = y.shape
+    which = 1 if ekf.output == "filtered" else 0
+    xs = np.empty((runs, n1, 6))
+    Ps = np.empty((runs, n1, 6, 6))
+    meas = ekf.measurement
+    for r in range(runs):
+        f = FilterpyEKF(dim_x=6, dim_z=3, dim_u=3)
+        f.x = np.array(xhat0, dtype=float)
+        f.P = ekf.P0.copy()
+        f.F, f.Q, f.R = ekf.F, ekf.Q, ekf.R
+        f.B = ekf.Gamma if ekf.uses_input else 0
+        for k in range(n1):
+            if k:
+                f.predict(u=u[r, k - 1] if ekf.uses_input else 0)
+            if not which:
+                xs[r, k], Ps[r, k] = f.x, f.P
+            f.update(y[r, k], meas.jacobian, meas.function, residual=meas.residual)
+            if which:
+                xs[r, k], Ps[r, k] = f.x, f.P
+    return xs, Ps
+
+
 # --- convergence to the Riccati steady state ------------------------------
 
 
 @pytest.mark.parametrize("output, field", [("filtered", "P_filtered"), ("predicted", "P_predicted")])
-def test_covariance_converges_to_dare(output, field):
-    # expected value: the DARE solution of hinfnav.kalman (scipy solve_discrete_are)
-    ekf = EKF(SCENARIO, output=output)
-    truth = simulate_truth(SCENARIO, maneuver=False, runs=1, seed=0)
-    P_end = ekf.estimate(truth.y, truth.u, SCENARIO.xhat0).P[0, -1]
-    P_dare = getattr(kalman_limit(SCENARIO, maneuver=False), field)
+def test_covariance_converges_to_dare(output, field, scenario):
+    # expected value: the DARE solution of kalman_limit (scipy solve_discrete_are)
+    ekf = EKF(scenario, output=output)
+    truth = simulate_truth(scenario.truth_model(maneuver=False), runs=1, seed=0)
+    P_end = ekf.estimate(truth.y, truth.u, scenario.xhat0).P[0, -1]
+    P_dare = getattr(kalman_limit(scenario, maneuver=False), field)
     np.testing.assert_allclose(P_end, P_dare, rtol=1e-8, atol=1e-12)
 
 
-def _assert_matches_limit(error, t, window, sigma, n_se=4.0):
-    """Per-axis RMS over runs and window vs sigma, within n_se standard errors.
-
-    The standard error is that of the mean over runs of the per-run mean
-    square (runs are independent; samples within a run are not), carried to
-    the RMS by the delta method.
-    """
-    per_run = rms_per_run(error, t, window) ** 2
-    rms = np.sqrt(per_run.mean(axis=0))
-    se = per_run.std(axis=0, ddof=1) / np.sqrt(per_run.shape[0]) / (2 * rms)
-    assert np.all(np.abs(rms - sigma) < n_se * se), (rms, sigma, se)
-    return rms, se
-
-
-def test_monte_carlo_rms_matches_riccati_without_maneuver():
+def test_monte_carlo_rms_matches_riccati_without_maneuver(scenario, assert_rms_matches):
     # expected value: sqrt(diag) of the filtered DARE solution, 0.0626 m and 0.0224 m/s
     # per axis (kalman_limit); tolerance: 4 standard errors of the 50-run mean
     # (measured ~0.15 % for position, ~2.5 % for velocity: the velocity error is slow)
-    res = simulate(SCENARIO, EKF(SCENARIO, keep_covariance=False), maneuver=False, runs=50, seed=11)
-    lim = kalman_limit(SCENARIO, maneuver=False)
+    res = simulate(scenario, EKF(scenario), maneuver=False, runs=50, seed=11)
+    lim = kalman_limit(scenario, maneuver=False)
     sigma = np.r_[lim.pos_m, lim.vel_mps]
-    rms, _ = _assert_matches_limit(res.error, res.t, SCENARIO.rms_window_s, sigma)
+    rms, _ = assert_rms_matches(res.error, res.t, scenario.rms_window_s, sigma)
     assert np.all(np.abs(rms[:3] / sigma[:3] - 1) < 0.01)
     assert np.all(np.abs(rms[3:] / sigma[3:] - 1) < 0.12)
 
@@ -75,13 +87,13 @@ def test_monte_carlo_rms_matches_riccati_without_maneuver():
 
 
 @pytest.fixture(scope="module")
-def maneuver_results():
-    truth = simulate_truth(SCENARIO, maneuver=True, runs=50, seed=3)
+def maneuver_results(scenario):
+    truth = simulate_truth(scenario.truth_model(maneuver=True), runs=50, seed=3)
     out = {}
     for known in (False, True):
-        hist = build_ekf(SCENARIO, known_input=known).estimate(truth.y, truth.u, SCENARIO.xhat0)
+        hist = build_ekf(scenario, known_input=known).estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False)
         out[known] = truth.x - hist.xhat
-    return truth.t, out
+    return truth.t, out, truth.state
 
 
 def test_unknown_input_ekf_fails_during_thrust(maneuver_results):
@@ -90,83 +102,129 @@ def test_unknown_input_ekf_fails_during_thrust(maneuver_results):
     # 100-500 s per-axis RMS ≈ (0.51, 0.43, 0.67) m and (3.2, 2.7, 4.3) m/s,
     # i.e. 7-11x the position limit 0.0626 m and >100x the velocity limit 0.0224 m/s
     # (paper, Fig 4: the EKF "cannot converge in the first 500 s")
-    t, err = maneuver_results
-    pos, vel = rms_error(err[False], t, (100.0, 500.0))
+    t, err, state = maneuver_results
+    pos, vel = pos_vel(rms_error(err[False], t, (100.0, 500.0)), state)
     assert np.all(pos > 0.3) and np.all(pos < 1.0)
     assert np.all(vel > 2.0) and np.all(vel < 6.0)
     # and recovers once the thrust has died away; measured 700-1000 s:
     # (0.063, 0.063, 0.063) m (the limit) and (0.045, 0.039, 0.040) m/s (2x the limit:
     # the residual thrust of a few N still pushes the velocity)
-    pos, vel = rms_error(err[False], t, (700.0, 1000.0))
+    pos, vel = pos_vel(rms_error(err[False], t, (700.0, 1000.0)), state)
     assert np.all(pos < 0.07) and np.all(vel < 0.07)
 
 
-def test_known_input_ekf_does_not_fail(maneuver_results):
+def test_known_input_ekf_does_not_fail(maneuver_results, scenario, assert_rms_matches):
     # expected value: told the applied thrust, the EKF's error obeys the open-loop
     # model whatever u is, so it sits at the maneuver=False Riccati limit (kalman_limit):
     # 0.0626 m, 0.0224 m/s per axis; tolerance 4 standard errors of the 50-run mean
-    t, err = maneuver_results
-    lim = kalman_limit(SCENARIO, maneuver=False)
-    _assert_matches_limit(err[True], t, (100.0, 500.0), np.r_[lim.pos_m, lim.vel_mps])
+    t, err, _ = maneuver_results
+    lim = kalman_limit(scenario, maneuver=False)
+    assert_rms_matches(err[True], t, (100.0, 500.0), np.r_[lim.pos_m, lim.vel_mps])
 
 
-def test_known_input_error_does_not_depend_on_the_maneuver():
+def test_known_input_error_does_not_depend_on_the_maneuver(short_scenario):
     # the known-input EKF's error recursion contains neither x nor u, so with the
     # same noise (same seed) its error histories with and without maneuver agree
     # up to rounding on states of ~1000 m
     errs = []
     for maneuver in (False, True):
-        res = simulate(SHORT, build_ekf(SHORT, known_input=True), maneuver=maneuver, runs=2, seed=6)
+        res = simulate(short_scenario, build_ekf(short_scenario, known_input=True), maneuver=maneuver, runs=2, seed=6)
         errs.append(res.error)
     np.testing.assert_allclose(errs[0], errs[1], rtol=0, atol=1e-8)
 
 
-def test_control_law_ekf_reaches_closed_loop_limit():
+def test_control_law_ekf_reaches_closed_loop_limit(scenario, assert_rms_matches):
     # expected value: the closed-loop Riccati limit, velocity 0.0135-0.0139 m/s (kalman_limit)
-    res = simulate(SCENARIO, EKF(SCENARIO, dynamics="control_law", keep_covariance=False), maneuver=True, runs=50, seed=5)
-    lim = kalman_limit(SCENARIO, maneuver=True)
-    _assert_matches_limit(res.error, res.t, SCENARIO.rms_window_s, np.r_[lim.pos_m, lim.vel_mps])
+    res = simulate(scenario, EKF(scenario, dynamics="control_law"), maneuver=True, runs=50, seed=5)
+    lim = kalman_limit(scenario, maneuver=True)
+    assert_rms_matches(res.error, res.t, scenario.rms_window_s, np.r_[lim.pos_m, lim.vel_mps])
 
 
-# --- vectorized gains == filterpy run by run ------------------------------
+# --- batched gains == filterpy run by run ---------------------------------
 
 
 @pytest.mark.parametrize("dynamics", ["unforced", "applied_thrust", "control_law"])
 @pytest.mark.parametrize("output", ["filtered", "predicted"])
-def test_vectorized_equals_filterpy_run_by_run(dynamics, output):
-    truth = simulate_truth(SHORT, maneuver=True, runs=3, seed=2)
-    fast = EKF(SHORT, dynamics=dynamics, output=output)
-    slow = EKF(SHORT, dynamics=dynamics, output=output, vectorized=False)
-    assert fast.vectorized and not slow.vectorized
-    a = fast.estimate(truth.y, truth.u, SHORT.xhat0)
-    b = slow.estimate(truth.y, truth.u, SHORT.xhat0)
-    np.testing.assert_allclose(a.xhat, b.xhat, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(a.P, b.P, rtol=0, atol=1e-12)
+def test_batched_equals_filterpy_run_by_run(dynamics, output, short_scenario):
+    # the batched filter (one shared covariance recursion for all runs) against filterpy's
+    # ExtendedKalmanFilter run by run on the same model, Q, R and P0
+    sc = short_scenario
+    truth = simulate_truth(sc.truth_model(maneuver=True), runs=3, seed=2)
+    fast = EKF(sc, dynamics=dynamics, output=output)
+    assert isinstance(fast, ExtendedKalmanFilter) and fast.vectorized and fast.shares_covariance
+    a = fast.estimate(truth.y, truth.u, sc.xhat0)
+    xs, Ps = filterpy_reference(fast, truth.y, truth.u, sc.xhat0)
+    np.testing.assert_allclose(a.xhat, xs, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.P, Ps, rtol=0, atol=1e-12)
 
 
-def test_timing_convention():
-    truth = simulate_truth(SHORT, maneuver=False, runs=1, seed=0)
-    pred = EKF(SHORT, output="predicted").estimate(truth.y, truth.u, SHORT.xhat0)
-    filt = EKF(SHORT, output="filtered").estimate(truth.y, truth.u, SHORT.xhat0)
+def test_range_angle_ekf_equals_filterpy_run_by_run(short_scenario):
+    # with the nonlinear measurement each run carries its own covariance; the batched update
+    # (Jacobian at each run's prior, wrapped angle residual) equals filterpy run by run
+    sc = short_scenario
+    truth = simulate_truth(sc.truth_model(maneuver=True), runs=2, seed=7)
+    C_bl = _rot(0.2, 0.1, -0.4)
+    y = range_angle_measurements(truth.x, np.random.default_rng(1), C_bl=C_bl)
+    ekf = build_ekf(sc, known_input=True, measurement="range_angles", C_bl=C_bl)
+    assert not ekf.shares_covariance
+    a = ekf.estimate(y, truth.u, sc.xhat0)
+    xs, Ps = filterpy_reference(ekf, y, truth.u, sc.xhat0)
+    np.testing.assert_allclose(a.xhat, xs, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.P, Ps, rtol=1e-9, atol=1e-12)
+
+
+def test_timing_convention(short_scenario):
+    sc = short_scenario
+    truth = simulate_truth(sc.truth_model(maneuver=False), runs=1, seed=0)
+    pred = EKF(sc, output="predicted").estimate(truth.y, truth.u, sc.xhat0)
+    filt = EKF(sc, output="filtered").estimate(truth.y, truth.u, sc.xhat0)
     # predicted estimate at t_0 is the prior; P(0|−1) = P0
-    np.testing.assert_array_equal(pred.xhat[0, 0], SHORT.xhat0)
+    np.testing.assert_array_equal(pred.xhat[0, 0], sc.xhat0)
     np.testing.assert_allclose(pred.P[0, 0], np.diag(DEFAULT_P0_STD**2))
     # the filtered one has used y(0): its position is within a few σ_v of y(0)
     assert np.all(np.abs(filt.xhat[0, 0, :3] - truth.y[0, 0]) < 0.5)
     # x̂(k+1|k) = Φ x̂(k|k) for the unforced model
-    Phi, _ = SHORT.truth_matrices(0.0, "exact")
+    Phi, _ = sc.truth_matrices(0.0, "exact")
     np.testing.assert_allclose(pred.xhat[0, 1:], filt.xhat[0, :-1] @ Phi.T, atol=1e-9)
 
 
-def test_registry_and_simulate():
-    ekf = make_estimator("ekf", SHORT)
-    known = make_estimator("ekf_known_input", SHORT)
+def test_step_contract_equals_batch_estimate(short_scenario):
+    # start / update / predict by hand (the loop a controller sits in) gives the batch numbers
+    sc = short_scenario
+    truth = simulate_truth(sc.truth_model(maneuver=True), runs=2, seed=4)
+    ekf = build_ekf(sc, known_input=True)
+    hist = ekf.estimate(truth.y, truth.u, sc.xhat0)
+    state = ekf.start(sc.xhat0, runs=2)
+    for k in range(truth.t.size):
+        state, out = ekf.update(state, truth.y[:, k])
+        np.testing.assert_array_equal(out.xhat, hist.xhat[:, k])
+        np.testing.assert_array_equal(out.P, hist.P[:, k])
+        state = ekf.predict(state, truth.u[:, k])
+
+
+def test_keep_covariance_and_diagnostics(short_scenario):
+    # estimate(keep_covariance=False) drops P (it replaces the old constructor argument);
+    # diagnostics=True returns the innovation history y(k) − C x̂(k|k−1)
+    sc = short_scenario
+    truth = simulate_truth(sc.truth_model(maneuver=False), runs=2, seed=0)
+    ekf = EKF(sc, output="predicted")
+    bare = ekf.estimate(truth.y, truth.u, sc.xhat0, keep_covariance=False)
+    assert bare.P is None
+    full = ekf.estimate(truth.y, truth.u, sc.xhat0, diagnostics=True)
+    np.testing.assert_array_equal(bare.xhat, full.xhat)
+    np.testing.assert_allclose(full.diagnostics["innovation"], truth.y - full.xhat[..., :3], rtol=0, atol=1e-12)
+
+
+def test_registry_and_simulate(short_scenario):
+    sc = short_scenario
+    ekf = make_estimator("ekf", sc)
+    known = make_estimator("ekf_known_input", sc)
     assert (ekf.name, ekf.uses_input, ekf.vectorized) == ("ekf", False, True)
     assert (known.name, known.uses_input, known.vectorized) == ("ekf_known_input", True, True)
-    res = simulate(SHORT, ekf, maneuver=False, runs=2, seed=0)
-    assert res.xhat.shape == (2, SHORT.n_steps + 1, 6)
-    assert res.P.shape == (2, SHORT.n_steps + 1, 6, 6)
-    again = simulate(SHORT, make_estimator("ekf", SHORT), maneuver=False, runs=2, seed=0)
+    res = simulate(sc, ekf, maneuver=False, runs=2, seed=0)
+    assert res.xhat.shape == (2, sc.n_steps + 1, 6)
+    assert res.P.shape == (2, sc.n_steps + 1, 6, 6)
+    again = simulate(sc, make_estimator("ekf", sc), maneuver=False, runs=2, seed=0)
     np.testing.assert_array_equal(res.xhat, again.xhat)
 
 
@@ -199,6 +257,11 @@ def test_range_angles_round_trip_and_jacobian():
         h = 1e-4
         num = np.column_stack([(range_angles(xi + h * e, C_bl) - range_angles(xi - h * e, C_bl)) / (2 * h) for e in np.eye(6)])
         np.testing.assert_allclose(J, num, rtol=1e-6, atol=1e-12)
+    # batched: one call on (k, 6) states gives the (k, 3, 6) stack of the single Jacobians
+    Jb = range_angles_jacobian(x[:5], C_bl)
+    assert Jb.shape == (5, 3, 6)
+    for i in range(5):
+        np.testing.assert_allclose(Jb[i], range_angles_jacobian(x[i], C_bl), rtol=1e-13, atol=1e-18)
 
 
 def test_range_angle_measurement_noise():
@@ -223,17 +286,17 @@ def test_range_angle_ekf_tracks():
     # indirect-measurement limit 0.0626 m (the default sigmas make the two
     # measurements about equally informative at ~1.3 km range)
     sc = Scenario(duration_s=200.0, rms_window_s=(50.0, 200.0))
-    truth = simulate_truth(sc, maneuver=False, runs=1, seed=4)
+    truth = simulate_truth(sc.truth_model(maneuver=False), runs=1, seed=4)
     C_bl = _rot(0.2, 0.1, -0.4)
     y = range_angle_measurements(truth.x, np.random.default_rng(9), C_bl=C_bl)
     ekf = build_ekf(sc, measurement="range_angles", C_bl=C_bl)
-    assert not ekf.vectorized and ekf.name == "ekf_range_angles"
+    assert not ekf.shares_covariance and ekf.name == "ekf_range_angles"
     hist = ekf.estimate(y, truth.u, sc.xhat0)
     err = truth.x - hist.xhat
     mask = truth.t >= 50.0
     nees = np.einsum("ki,kij,kj->k", err[0, mask], np.linalg.inv(hist.P[0, mask]), err[0, mask]) / 6
     assert 0.7 < nees.mean() < 1.3
-    pos, vel = rms_error(err, truth.t, (50.0, 200.0))
+    pos, vel = pos_vel(rms_error(err, truth.t, (50.0, 200.0)), truth.state)
     assert np.all(pos < 0.12) and np.all(vel < 0.04)
 
 
@@ -256,43 +319,55 @@ def test_range_angle_ekf_tracks():
         ({"sigma_range": 0.1}, "sigma_range applies only"),
         ({"measurement": "range_angles", "sigma_range": 0.0}, "sigma_range must be > 0"),
         ({"measurement": "range_angles", "sigma_angle": -1e-4}, "sigma_angle must be > 0"),
-        ({"measurement": "range_angles", "vectorized": True}, "vectorized"),
         ({"measurement": "range_angles", "C_bl": 2 * np.eye(3)}, "C_bl must be a rotation"),
-        ({"keep_covariance": "yes"}, "keep_covariance"),
         ({"scenario": "paper"}, "scenario"),
     ],
 )
-def test_bad_options(kwargs, match):
+def test_bad_options(kwargs, match, short_scenario):
     kwargs = dict(kwargs)
-    scenario = kwargs.pop("scenario", SHORT)
+    scenario = kwargs.pop("scenario", short_scenario)
     with pytest.raises(InputError, match=match):
         EKF(scenario, **kwargs)
 
 
-def test_build_ekf_bad_options():
+def test_removed_options_are_rejected(short_scenario):
+    # vectorized= and keep_covariance= are no longer options of EKF: every estimator is
+    # batched (shares_covariance says whether the gains depend on the data) and the covariance
+    # history is asked of estimate(keep_covariance=...)
+    for option in ({"vectorized": True}, {"keep_covariance": False}):
+        with pytest.raises(TypeError, match=next(iter(option))):
+            EKF(short_scenario, **option)
+
+
+def test_build_ekf_bad_options(short_scenario):
+    sc = short_scenario
     with pytest.raises(InputError, match="known_input"):
-        build_ekf(SHORT, known_input="yes")
+        build_ekf(sc, known_input="yes")
     with pytest.raises(InputError, match="contradicts known_input"):
-        build_ekf(SHORT, known_input=True, dynamics="unforced")
+        build_ekf(sc, known_input=True, dynamics="unforced")
     with pytest.raises(InputError, match="contradicts known_input"):
-        build_ekf(SHORT, known_input=False, dynamics="applied_thrust")
-    assert build_ekf(SHORT, dynamics="control_law").name == "ekf_control_law"
+        build_ekf(sc, known_input=False, dynamics="applied_thrust")
+    assert build_ekf(sc, dynamics="control_law").name == "ekf_control_law"
 
 
-def test_bad_estimate_arguments():
-    ekf = EKF(SHORT)
-    n1 = SHORT.n_steps + 1
+def test_bad_estimate_arguments(short_scenario):
+    sc = short_scenario
+    ekf = EKF(sc)
+    n1 = sc.n_steps + 1
     y, u = np.zeros((1, n1, 3)), np.zeros((1, n1, 3))
     with pytest.raises(InputError, match="y must have 3 measurement channels"):
-        ekf.estimate(np.zeros((1, n1, 2)), u, SHORT.xhat0)
+        ekf.estimate(np.zeros((1, n1, 2)), u, sc.xhat0)
     with pytest.raises(InputError, match="u must have shape"):
-        ekf.estimate(y, np.zeros((1, n1 - 1, 3)), SHORT.xhat0)
-    with pytest.raises(InputError, match="u must have 3 thrust channels"):
-        ekf.estimate(y, np.zeros((1, n1, 2)), SHORT.xhat0)
+        ekf.estimate(y, np.zeros((1, n1 - 1, 3)), sc.xhat0)
+    # the thrust channels are checked where the thrust is used
+    with pytest.raises(InputError, match="u must have 3 input channels"):
+        build_ekf(sc, known_input=True).estimate(y, np.zeros((1, n1, 2)), sc.xhat0)
     with pytest.raises(InputError, match="xhat0 must have 6 entries"):
         ekf.estimate(y, u, np.zeros(5))
     with pytest.raises(InputError, match="y must have shape"):
-        ekf.estimate(np.zeros((n1, 3)), u, SHORT.xhat0)
+        ekf.estimate(np.zeros((n1, 3)), u, sc.xhat0)
+    with pytest.raises(InputError, match="predict needs u"):
+        build_ekf(sc, known_input=True).predict(ekf.start(sc.xhat0))
 
 
 def test_bad_range_angle_arguments():
@@ -301,11 +376,12 @@ def test_bad_range_angle_arguments():
         range_angle_measurements(x, 0)
     with pytest.raises(InputError, match="sigma_range must be >= 0"):
         range_angle_measurements(x, np.random.default_rng(0), sigma_range=-1)
+    # any state whose first three components are the position is accepted; fewer are not
     with pytest.raises(InputError, match="x must have shape"):
-        range_angles(np.ones((4, 4)))
+        range_angles(np.ones((4, 2)))
     with pytest.raises(InputError, match="zero relative position"):
         range_angles(np.zeros(6))
-    with pytest.raises(InputError, match="body z axis"):
+    with pytest.raises(InputError, match="sensor z axis"):
         range_angles_jacobian(np.array([0, 0, 5.0, 0, 0, 0]))
     with pytest.raises(InputError, match="m must have shape"):
         position_from_range_angles(np.ones((3, 2)))

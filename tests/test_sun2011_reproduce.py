@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from hinfnav.reproduction import PAPER_TABLE1, reproduce, table1
+from hinfnav.papers.sun2011 import PAPER_TABLE1, reproduce, table1
 
 RUNS = 8
 

@@ -5,15 +5,17 @@ import pytest
 import scipy.linalg
 
 from hinfnav import InputError, Scenario, infer_sampling_time, published_filter
-from hinfnav.models import measurement_matrix, spectral_radius
+from hinfnav.core import spectral_radius
+from hinfnav.sim import TruthModel
+from hinfnav.systems import LinearMeasurement, LinearSystem, measurement_matrix
 
 
-def test_sampling_time_inferred_from_published_filter():
+def test_sampling_time_inferred_from_published_filter(scenario):
     # A_F[:3, 3:] = T·I and A_F[:3, :3] − B_F[:3] = I for an observer-form filter of (6) (see docstring)
     T, residual = infer_sampling_time()
     assert T == pytest.approx(0.1, abs=1e-12)
     assert residual < 1e-12  # exact in the printed digits
-    assert Scenario().dt == pytest.approx(T)
+    assert scenario.dt == pytest.approx(T)
 
 
 def test_sampling_time_inference_recovers_a_known_T():
@@ -36,10 +38,10 @@ def test_published_filter_is_stable_and_estimates_minus_its_state():
     assert np.max(np.abs(pub.C_F + np.eye(6))) < 7.4e-5
 
 
-def test_published_filter_is_close_to_a_predictor_observer_of_the_closed_loop():
+def test_published_filter_is_close_to_a_predictor_observer_of_the_closed_loop(scenario):
     # structure consistency: with x̂ = C_F x_f the filter reads x̂⁺ = Â x̂ + G y with
     # Â ≈ A − G C, A = I + T(A₁+G₀K); printed digits agree to 3.5e-4
-    s = Scenario()
+    s = scenario
     pub = published_filter()
     A = s.design_model().A
     Ci = np.linalg.inv(pub.C_F)
@@ -48,9 +50,9 @@ def test_published_filter_is_close_to_a_predictor_observer_of_the_closed_loop():
     assert np.max(np.abs(Ahat - (A - G @ measurement_matrix()))) < 3.5e-4
 
 
-def test_scenario_defaults_are_the_papers():
+def test_scenario_defaults_are_the_papers(scenario):
     # Section 4 of the paper
-    s = Scenario()
+    s = scenario
     assert s.omega0 == 7.2722e-5 and s.mass == 1000.0
     np.testing.assert_array_equal(s.x0, [600, 550, 1040, 0.02, -0.08, 0.03])
     np.testing.assert_array_equal(s.xhat0, [630, 520, 1000, 0, 0, 0])
@@ -63,15 +65,15 @@ def test_scenario_defaults_are_the_papers():
         s.K[0, 0] = 1.0
 
 
-def test_24h_orbit_rate():
+def test_24h_orbit_rate(scenario):
     # ω₀ = 2π / 86400 s (a 24 h orbit; the paper prints 7.2722e-5 rad/s)
-    assert Scenario().omega0 == pytest.approx(2 * np.pi / 86400, rel=1e-4)
+    assert scenario.omega0 == pytest.approx(2 * np.pi / 86400, rel=1e-4)
 
 
-def test_thrust_decays_in_the_first_500_s():
+def test_thrust_decays_in_the_first_500_s(scenario):
     # continuous closed-loop poles of A₁ + G₀K: slowest real part about -0.0096 1/s,
     # so the thrust falls below 5 % of its start in about 500 s (the paper's Fig 6 text)
-    s = Scenario()
+    s = scenario
     A1, G0 = s.continuous_matrices()
     ev = np.linalg.eigvals(A1 + G0 @ s.K)
     assert ev.real.max() == pytest.approx(-0.0096, abs=5e-4)
@@ -96,6 +98,42 @@ def test_scenario_bad_input(kwargs, message):
         Scenario(**kwargs)
 
 
-def test_truth_matrices_reject_nonphysical_delta():
+def test_truth_matrices_reject_nonphysical_delta(scenario):
     with pytest.raises(InputError, match="delta must be > -1"):
-        Scenario().truth_matrices(-1.5)
+        scenario.truth_matrices(-1.5)
+    with pytest.raises(InputError, match="delta must be > -1"):
+        scenario.truth_model(delta=-1.5)
+
+
+def test_generic_objects_are_the_scenarios_matrices(scenario):
+    # system(), measurement, controller() and truth_model() hand the generic layers exactly the
+    # matrices of truth_matrices(), (8) and (3)
+    s = scenario
+    for delta, disc in ((0.0, "exact"), (0.3, "euler")):
+        Phi, Gamma = s.truth_matrices(delta, disc)
+        sysm = s.system(delta, disc)
+        assert isinstance(sysm, LinearSystem)
+        np.testing.assert_array_equal(sysm.Phi, Phi)
+        np.testing.assert_array_equal(sysm.Gamma, Gamma)
+        np.testing.assert_array_equal(sysm.B, s.B)
+        assert sysm.dt == s.dt
+        loop = s.system(delta, disc, closed_loop=True)
+        np.testing.assert_array_equal(loop.Phi, Phi + Gamma @ s.K)
+        assert loop.n_input == 0
+    assert isinstance(s.measurement, LinearMeasurement)
+    np.testing.assert_array_equal(s.measurement.C, measurement_matrix())
+    np.testing.assert_array_equal(s.measurement.D, s.D)
+    np.testing.assert_array_equal(s.controller().K, s.K)
+    assert s.controller(maneuver=False) is None
+    model = s.truth_model(maneuver=True, delta=0.2, discretization="euler")
+    assert isinstance(model, TruthModel)
+    np.testing.assert_array_equal(model.system.Phi, s.truth_matrices(0.2, "euler")[0])
+    np.testing.assert_array_equal(model.x0, s.x0)
+    assert model.n_steps == s.n_steps and model.controller.source == "truth"
+    np.testing.assert_allclose(model.time, s.time, rtol=0, atol=0)
+    assert model.settings == {"maneuver": True, "delta": 0.2, "discretization": "euler"}
+    assert s.truth_model(maneuver=False).controller is None
+    with pytest.raises(InputError, match="maneuver must be True or False"):
+        s.truth_model(maneuver="yes")
+    with pytest.raises(InputError, match="unknown discretization 'rk4'"):
+        s.truth_model(discretization="rk4")

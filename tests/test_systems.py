@@ -1,16 +1,17 @@
-"""Model identities of Sections 1 and 4 of the paper."""
+"""Model identities of Sections 1 and 4 of the paper (hinfnav.systems, hinfnav.core.linalg)."""
 
 import numpy as np
 import pytest
 import scipy.linalg
 
-from hinfnav import InputError, Scenario
-from hinfnav.models import (
+from hinfnav.core import InputError, discretize, spectral_radius
+from hinfnav.systems import (
     UncertainSystem,
     delta_A1,
-    discretize,
     hill_matrices,
-    spectral_radius,
+    hill_system,
+    measurement_matrix,
+    position_measurement,
     uncertainty_F,
     uncertainty_structure,
 )
@@ -65,9 +66,9 @@ def test_uncertainty_F_rejects_delta_outside_bound():
         uncertainty_structure(W0, -0.1)
 
 
-def test_euler_versus_exact_discretization():
+def test_euler_versus_exact_discretization(scenario):
     # Taylor series: e^{AT} = I + AT + A²T²/2 + O(T³), ∫e^{As}ds G = TG + AGT²/2 + O(T³)
-    s = Scenario()
+    s = scenario
     A0, G0 = hill_matrices(W0, 1000.0)
     Ac = A0 + G0 @ s.K
     for T in (0.1, 0.01):
@@ -86,9 +87,9 @@ def test_euler_versus_exact_discretization():
     assert np.max(np.abs(Px - Pe)) == pytest.approx(0.005 * 24.2818e-3, rel=0.01)
 
 
-def test_euler_discretization_matches_design_model():
+def test_euler_discretization_matches_design_model(scenario):
     # (6): A = I + T(A₁ + G₀K), computed two ways
-    s = Scenario()
+    s = scenario
     A0, G0 = hill_matrices(s.omega0, s.mass)
     Pe, Ge = discretize(A0, G0, s.dt, "euler")
     np.testing.assert_allclose(s.design_model().A, Pe + Ge @ s.K, rtol=1e-15, atol=1e-17)
@@ -107,8 +108,8 @@ def test_discretize_bad_input():
         discretize(np.array([[np.nan]]), np.ones((1, 1)), 0.1)
 
 
-def test_uncertain_system_validation():
-    s = Scenario().design_model()
+def test_uncertain_system_validation(scenario):
+    s = scenario.design_model()
     with pytest.raises(InputError, match="B must have shape 6xany"):
         UncertainSystem(s.A, np.ones((5, 2)), s.C, s.D, s.L)
     with pytest.raises(InputError, match="H and E must be given together"):
@@ -119,10 +120,33 @@ def test_uncertain_system_validation():
         UncertainSystem(s.A, s.B, s.C, s.D, s.L, H=s.H, E=np.ones((2, 6)))
 
 
-def test_closed_loop_is_schur_stable_and_open_loop_is_not():
+def test_closed_loop_is_schur_stable_and_open_loop_is_not(scenario):
     # closed loop ρ(I + T(A₁+G₀K)) = 0.99904 (< 1); open loop ρ(I + T A₁) = |1 + iωT| > 1
-    s = Scenario()
+    s = scenario
     assert spectral_radius(s.design_model().A) == pytest.approx(0.999039, abs=1e-6)
     A1, _ = hill_matrices(s.omega0, s.mass)
     assert spectral_radius(np.eye(6) + s.dt * A1) == pytest.approx(abs(1 + 1j * s.omega0 * s.dt), rel=1e-12)
     assert spectral_radius(np.eye(6) + s.dt * A1) > 1.0
+
+
+def test_hill_system_is_the_discretized_hill_model(scenario):
+    # hill_system = discretize(hill_matrices) (the same zero-order hold), with B, dt and the chaser's labels;
+    # with K it is the closed loop Φ + ΓK without input
+    s = scenario
+    A0, G0 = hill_matrices(s.omega0, s.mass)
+    for method in ("exact", "euler"):
+        Phi, Gam = discretize(A0, G0, s.dt, method)
+        sysm = hill_system(s.omega0, s.mass, s.dt, s.B, discretization=method)
+        np.testing.assert_array_equal(sysm.Phi, Phi)
+        np.testing.assert_array_equal(sysm.Gamma, Gam)
+        np.testing.assert_array_equal(sysm.Q, s.B @ s.B.T)
+        assert sysm.dt == s.dt and sysm.n == 6 and sysm.n_input == 3
+        loop = hill_system(s.omega0, s.mass, s.dt, s.B, K=s.K, discretization=method)
+        np.testing.assert_allclose(loop.Phi, Phi + Gam @ s.K, rtol=0, atol=0)
+        assert loop.n_input == 0
+    assert sysm.state.labels == ("x", "y", "z", "vx", "vy", "vz")
+    assert sysm.state.indices("position") == (0, 1, 2) and sysm.state.indices("velocity") == (3, 4, 5)
+    # (8): y = [I 0] x + D v
+    meas = position_measurement(s.D)
+    np.testing.assert_array_equal(meas.C, measurement_matrix())
+    np.testing.assert_array_equal(meas.R, s.D @ s.D.T)

@@ -78,7 +78,7 @@ def discretize(Ac, Gc, dt, method="exact"):
     Notes
     -----
     The two agree to first order in T; the Euler error is
-    ``T² Ac²/2 + O(T³)`` (tested in ``tests/test_models.py``).
+    ``T² Ac²/2 + O(T³)`` (tested in ``tests/test_systems.py``).
     """
     Ac = as_matrix("Ac", Ac)
     n = Ac.shape[0]

@@ -5,6 +5,7 @@ the solver reported.
 """
 
 from ..lmi.solve import SOLVERS, SolverOptions
+from .io import check_design_system, load_design, save_design, system_fingerprint
 from .result import SynthesisResult
 from .robust_hinf import FORMS, synthesize
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
@@ -19,4 +20,8 @@ __all__ = [
     "default_uncertainty_samples",
     "check_samples",
     "check_plant",
+    "save_design",
+    "load_design",
+    "check_design_system",
+    "system_fingerprint",
 ]

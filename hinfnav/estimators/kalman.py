@@ -15,7 +15,7 @@ With a linear measurement and one initial covariance for all runs the
 covariance and gain do not depend on the data: P is then carried once (2-D)
 and shared by every run, so a batch of R runs costs one covariance recursion.
 The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
-(Joseph form), which ``tests/test_estimators_kalman.py`` checks run by run.
+(Joseph form), which the test suite checks run by run.
 """
 
 import numpy as np

@@ -12,6 +12,7 @@ from .errors import (
     rms_per_run,
     window_mask,
 )
+from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
 
 __all__ = [
     "window_mask",
@@ -24,4 +25,7 @@ __all__ = [
     "by_group",
     "group_rms",
     "axes_rms",
+    "monte_carlo_statistics",
+    "MonteCarloStatistics",
+    "WindowStatistics",
 ]

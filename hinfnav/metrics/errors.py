@@ -36,6 +36,12 @@ def _check_error(error, t):
     t = np.asarray(t, dtype=float)
     if t.shape != (error.shape[1],):
         raise InputError(f"t must have shape ({error.shape[1]},) to match error; got {t.shape}")
+    if not np.all(np.isfinite(error)):
+        bad = np.argwhere(~np.isfinite(error))[0]
+        raise InputError(
+            f"error must be finite; it has NaN or inf (first at run {bad[0]}, sample {bad[1]}, component {bad[2]}): "
+            "the estimator diverged or the data are corrupt, so an RMS would be meaningless"
+        )
     return error, t
 
 

@@ -1,7 +1,7 @@
 """Simulation layer: open-loop truth, closed loop, Monte Carlo with seeding and batching."""
 
 from .closed_loop import simulate_closed_loop
-from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate
+from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate, simulate_batches
 from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
 
 __all__ = [
@@ -10,6 +10,7 @@ __all__ = [
     "SimulationResult",
     "simulate_truth",
     "simulate",
+    "simulate_batches",
     "run_estimator",
     "resolve_estimator",
     "simulate_closed_loop",

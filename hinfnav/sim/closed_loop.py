@@ -14,6 +14,7 @@ from tqdm import tqdm
 from ..control.feedback import LinearFeedback
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least
+from ..core.progress import bar_disabled
 from .montecarlo import SimulationResult, resolve_estimator
 from .truth import child_rngs, draw_noise, noise_models
 
@@ -60,7 +61,7 @@ def simulate_closed_loop(scenario, estimator, controller=None, *, noise="gaussia
     system, meas = model.system, model.measurement
     if controller.n_input != system.n_input or controller.n_state != system.n:
         raise InputError(f"controller gain must be {system.n_input}x{system.n}; got {controller.K.shape}")
-    w_model, v_model = noise_models(noise, measurement_noise)
+    w_model, v_model = noise_models(noise, measurement_noise, system.dt)
     n1 = model.n_steps + 1
     w, v = draw_noise(w_model, v_model, child_rngs(seed, runs), n1, system.n_noise, meas.n_noise)
     x = np.empty((runs, n1, system.n))
@@ -69,7 +70,7 @@ def simulate_closed_loop(scenario, estimator, controller=None, *, noise="gaussia
     y = np.empty((runs, n1, meas.n_meas))
     x[:, 0] = model.x0
     state = estimator.start(np.asarray(scenario.xhat0, dtype=float), P0, runs)
-    for k in tqdm(range(n1), disable=not progress, desc=f"closed loop ({estimator.name})", unit="step", leave=False):
+    for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({estimator.name})", unit="step", leave=False):
         y[:, k] = meas.measure(x[:, k], v[:, k])
         state, out = estimator.update(state, y[:, k])
         xhat[:, k] = out.xhat

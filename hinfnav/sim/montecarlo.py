@@ -17,11 +17,13 @@ from tqdm import tqdm
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least
+from ..core.progress import bar_disabled
+from ..design.result import SynthesisResult
 from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator
 from .truth import simulate_truth
 
-__all__ = ["SimulationResult", "run_estimator", "simulate", "resolve_estimator"]
+__all__ = ["SimulationResult", "check_measurement_match", "run_estimator", "simulate", "simulate_batches", "resolve_estimator"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,14 +69,41 @@ class SimulationResult:
 
 
 def resolve_estimator(estimator, scenario):
-    """An :class:`Estimator`, or the one registered under a name for ``scenario``."""
+    """An :class:`Estimator`: given, registered under a name for ``scenario``, or built from a design.
+
+    A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
+    the scenario's ``estimator_from_design`` (which checks that it was
+    designed for this scenario's sampling time).
+    """
     if isinstance(estimator, str):
         return build_estimator(estimator, scenario)
+    if isinstance(estimator, SynthesisResult):
+        if not hasattr(scenario, "estimator_from_design"):
+            raise InputError(f"this scenario ({type(scenario).__name__}) cannot run a synthesized design directly")
+        return scenario.estimator_from_design(estimator)
     if estimator is None:
         raise InputError("estimator must be given (an Estimator or a registered filter name such as 'published')")
     if not isinstance(estimator, Estimator):
         raise InputError(f"estimator must be a hinfnav Estimator or a filter name; got {type(estimator).__name__}")
     return estimator
+
+
+def check_measurement_match(estimator, measurement):
+    """Refuse an estimator whose measurement model is not what the simulation produces.
+
+    An estimator built for range, azimuth and elevation must not be fed
+    Cartesian positions (nor the reverse): the channels' labels and units must agree.
+    """
+    if measurement is None:
+        return
+    mine = estimator.measurement
+    if (mine.n_meas, tuple(mine.labels), tuple(mine.units)) != (measurement.n_meas, tuple(measurement.labels),
+                                                                tuple(measurement.units)):
+        raise InputError(
+            f"estimator {estimator.name!r} expects measurements {', '.join(f'{a} ({b})' for a, b in zip(mine.labels, mine.units))} "
+            f"but the scenario produces {', '.join(f'{a} ({b})' for a, b in zip(measurement.labels, measurement.units))}: "
+            "simulate the measurements the estimator was built for, or build it for the scenario's measurement"
+        )
 
 
 def run_estimator(estimator, truth, xhat0, *, P0=None, diagnostics=False):
@@ -86,6 +115,7 @@ def run_estimator(estimator, truth, xhat0, *, P0=None, diagnostics=False):
     """
     if not isinstance(estimator, Estimator):
         raise InputError(f"estimator must be a hinfnav Estimator; got {type(estimator).__name__}")
+    check_measurement_match(estimator, truth.measurement)
     hist = estimator.estimate(truth.y, truth.u, xhat0, P0, diagnostics=diagnostics)
     if not isinstance(hist, EstimateHistory) or hist.xhat.shape != truth.x.shape:
         raise InputError(
@@ -109,6 +139,29 @@ def _concat_covariances(Ps, runs):
     if shared:
         return np.broadcast_to(Ps[0][0], (runs,) + Ps[0].shape[1:])
     return np.concatenate(Ps)
+
+
+def simulate_batches(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
+                     progress=False, **conditions):
+    """Yield ``(first_run, SimulationResult)`` batch by batch: histories of ``batch_size`` runs at a time.
+
+    Memory is that of one batch, whatever ``runs``; the numbers of run r do not
+    depend on the batch size (run r always draws from the r-th child generator).
+    Arguments as in :func:`simulate`.
+    """
+    model = scenario.truth_model(**conditions)
+    estimator = resolve_estimator(estimator, scenario)
+    runs = as_int_at_least("runs", runs, 1)
+    batch_size = as_int_at_least("batch_size", batch_size, 1)
+    if isinstance(seed, np.random.Generator):
+        seed = int(seed.integers(2**63))
+    with tqdm(total=runs, disable=bar_disabled(progress), desc=f"{estimator.name}", unit="run") as bar:
+        for start in range(0, runs, batch_size):
+            n = min(batch_size, runs - start)
+            truth = simulate_truth(model, noise=noise, measurement_noise=measurement_noise, runs=n, seed=seed,
+                                   first_run=start)
+            yield start, run_estimator(estimator, truth, scenario.xhat0)
+            bar.update(n)
 
 
 def simulate(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
@@ -137,22 +190,12 @@ def simulate(scenario, estimator, *, noise="gaussian", measurement_noise=None, r
     Returns
     -------
     SimulationResult
-        Histories of all runs.
+        Histories of all runs (memory grows with ``runs``; for statistics
+        only, :func:`hinfnav.metrics.monte_carlo_statistics` streams).
     """
-    model = scenario.truth_model(**conditions)
-    estimator = resolve_estimator(estimator, scenario)
-    runs = as_int_at_least("runs", runs, 1)
-    batch_size = as_int_at_least("batch_size", batch_size, 1)
-    if isinstance(seed, np.random.Generator):
-        seed = int(seed.integers(2**63))
-    parts = []
-    with tqdm(total=runs, disable=not progress, desc=f"{estimator.name}", unit="run") as bar:
-        for start in range(0, runs, batch_size):
-            n = min(batch_size, runs - start)
-            truth = simulate_truth(model, noise=noise, measurement_noise=measurement_noise, runs=n, seed=seed,
-                                   first_run=start)
-            parts.append(run_estimator(estimator, truth, scenario.xhat0))
-            bar.update(n)
+    parts = [res for _, res in simulate_batches(scenario, estimator, noise=noise, measurement_noise=measurement_noise,
+                                                runs=runs, seed=seed, batch_size=batch_size, progress=progress,
+                                                **conditions)]
     if len(parts) == 1:
         res = parts[0]
         res.settings["runs"] = runs

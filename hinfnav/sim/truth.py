@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_vector
-from ..noise import make_noise
+from ..noise import ColoredNoise, make_noise
 
 __all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth"]
 
@@ -81,6 +81,8 @@ class Truth:
         Measurements.
     settings : dict
     state : StateSpec
+    measurement : MeasurementModel
+        What produced ``y`` (estimators are checked against it).
     """
 
     t: np.ndarray
@@ -89,6 +91,7 @@ class Truth:
     y: np.ndarray
     settings: dict = field(default_factory=dict)
     state: object = None
+    measurement: object = None
 
 
 def child_rngs(seed, runs):
@@ -100,10 +103,25 @@ def child_rngs(seed, runs):
     return np.random.default_rng(seed).spawn(runs)
 
 
-def noise_models(noise, measurement_noise=None):
-    """The process- and measurement-noise models (the second defaults to the first)."""
-    w_model = make_noise(noise)
-    v_model = w_model if measurement_noise is None else make_noise(measurement_noise)
+def _noise_at(noise, dt, name):
+    """A noise model for a system sampled at ``dt``: colored noise is built at that T, or refused at another."""
+    if isinstance(noise, str) and noise == "colored" and dt is not None:
+        return make_noise("colored", dt=dt)
+    model = make_noise(noise)
+    if dt is not None and isinstance(model, ColoredNoise) and abs(model.dt - dt) > 1e-12 * dt:
+        raise InputError(f"{name}: colored noise built for dt = {model.dt:g} s cannot drive a system sampled at "
+                         f"dt = {dt:g} s (its correlation time would be wrong); use ColoredNoise(dt={dt:g}, ...)")
+    return model
+
+
+def noise_models(noise, measurement_noise=None, dt=None):
+    """The process- and measurement-noise models (the second defaults to the first).
+
+    With ``dt`` (the system's sampling time, s), colored noise given by name is
+    built at that T, and a colored-noise model built for another T is refused.
+    """
+    w_model = _noise_at(noise, dt, "noise")
+    v_model = w_model if measurement_noise is None else _noise_at(measurement_noise, dt, "measurement_noise")
     return w_model, v_model
 
 
@@ -143,8 +161,8 @@ def simulate_truth(model, *, noise="gaussian", measurement_noise=None, runs=1, s
         raise InputError(f"model must be a hinfnav TruthModel; got {type(model).__name__}")
     runs = as_int_at_least("runs", runs, 1)
     first_run = as_int_at_least("first_run", first_run, 0)
-    w_model, v_model = noise_models(noise, measurement_noise)
     system, meas = model.system, model.measurement
+    w_model, v_model = noise_models(noise, measurement_noise, system.dt)
     n1 = model.n_steps + 1
     rngs = child_rngs(seed, first_run + runs)[first_run:]
     w, v = draw_noise(w_model, v_model, rngs, n1, system.n_noise, meas.n_noise)
@@ -169,4 +187,4 @@ def simulate_truth(model, *, noise="gaussian", measurement_noise=None, runs=1, s
         runs=runs,
         seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
     )
-    return Truth(t=model.time, x=x, u=u, y=y, settings=settings, state=system.state)
+    return Truth(t=model.time, x=x, u=u, y=y, settings=settings, state=system.state, measurement=meas)

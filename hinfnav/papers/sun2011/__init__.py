@@ -19,6 +19,8 @@ from .designs import (
     design_report,
     format_design_report,
     gamma_sweep,
+    load_design,
+    save_design,
 )
 from .ekf import EKF, build_ekf, range_angle_measurements
 from .filters import FILTER_NAMES, lti_from_matrices, make_estimator
@@ -55,6 +57,8 @@ __all__ = [
     "design_report",
     "format_design_report",
     "compare_with_published",
+    "save_design",
+    "load_design",
     "Table1",
     "table1",
     "table1_rows",

@@ -163,7 +163,7 @@ def plot_closed_loop(study, *, axes=None, run=0):
         axes = grid[0]
     fig = axes[0].figure
     for i, (key, res) in enumerate(study.results.items()):
-        label = study.rows[i]["label"].split(",")[0] if key == "truth" else study.rows[i]["label"][8:]
+        label = study.rows[i]["label"].split(", ", 1)[-1]  # drop "u = K x̂, " (x̂ is two code points)
         r = np.linalg.norm(res.state.select(res.x[run], "position"), axis=-1)
         axes[0].semilogy(res.t, np.maximum(r, 1e-3), lw=1, label=label)
         axes[1].plot(res.t, np.linalg.norm(res.u[run], axis=-1), lw=1, label=label)

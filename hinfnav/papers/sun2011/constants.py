@@ -106,12 +106,16 @@ class PublishedFilter:
     C_F : ndarray, shape (6, 6)
     delta_bar : float
         The uncertainty bound it was designed for, 0.05.
+    dt : float
+        The sampling time it was designed for, s: not printed, 0.1 s read off
+        A_F and B_F by :func:`infer_sampling_time`.
     """
 
     A_F: np.ndarray
     B_F: np.ndarray
     C_F: np.ndarray
     delta_bar: float = 0.05
+    dt: float = 0.1
 
 
 def published_filter():

@@ -18,6 +18,8 @@ from ...analysis.norms import channel_norms, hinf_norm
 from ...analysis.observer import observer_form
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_nonnegative
+from ...core.progress import bar_disabled
+from ...design import io as design_io
 from ...design.robust_hinf import synthesize
 from ...design.samples import SampleSet
 from ...lmi.conditioning import prepare_uncertainty
@@ -35,6 +37,8 @@ __all__ = [
     "design_report",
     "format_design_report",
     "compare_with_published",
+    "save_design",
+    "load_design",
 ]
 
 
@@ -192,7 +196,7 @@ def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **
     """
     dbs = np.array([as_nonnegative("delta_bars entry", d) for d in delta_bars], dtype=float)
     results = []
-    for d in tqdm(dbs, disable=not progress, desc="γ*(δ̄)", unit="design"):
+    for d in tqdm(dbs, disable=bar_disabled(progress), desc="γ*(δ̄)", unit="design"):
         results.append(design_for_scenario(scenario, d, **options))
     return GammaSweep(dbs, tuple(results))
 
@@ -368,3 +372,35 @@ def compare_with_published(scenario=None, solver=None, delta_points=21, design=N
     }
 
 
+
+
+def save_design(result, path, scenario=None):
+    """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
+
+    The file holds the filter, its certificate, the uncertain system ψ_d of
+    the scenario at the design's δ̄ (with its fingerprint and T), the design
+    options and provenance (:mod:`hinfnav.design.io`). Returns the path.
+    """
+    scenario = Scenario() if scenario is None else scenario
+    delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
+    system = scenario.design_model(delta_bar)
+    options = {"delta_bar": delta_bar, "form": result.form, "structure": result.structure, "solver": result.solver}
+    extra = {"paper": "sun2011", "scenario": {"dt_s": scenario.dt, "omega0": scenario.omega0, "mass": scenario.mass}}
+    return design_io.save_design(result, system, path, options=options, extra=extra)
+
+
+def load_design(path, scenario=None):
+    """Load a design file and check it was made for ``scenario`` (default the paper's).
+
+    Raises
+    ------
+    InputError
+        If the file is not a design, was edited, or was designed for another
+        system (another T, B, D, K, …): the message names what differs.
+    """
+    scenario = Scenario() if scenario is None else scenario
+    result, system, _ = design_io.load_design(path)
+    delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
+    design_io.check_design_system(system, system.dt, scenario.design_model(delta_bar), scenario.dt,
+                                  what="the scenario")
+    return result

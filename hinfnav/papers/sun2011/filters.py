@@ -21,7 +21,6 @@ name                       estimator
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
-from ...estimators.lti import LTIFilter
 from ...estimators.registry import register_estimator
 from .constants import published_filter
 from .designs import design_for_scenario
@@ -33,7 +32,7 @@ __all__ = ["FILTER_NAMES", "make_estimator", "lti_from_matrices"]
 FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer", "ekf", "ekf_known_input")
 
 
-def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
+def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True, design_dt=None):
     """Wrap filter matrices designed on ``scenario``'s closed loop as an estimator.
 
     Parameters
@@ -46,6 +45,10 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
     uses_input : bool
         Tell the filter the applied thrust (the default); False runs (12)
         as printed, assuming u = K x.
+    design_dt : float, optional
+        The sampling time the filter was designed for, s; an
+        :class:`~hinfnav.core.exceptions.InputError` if it is not the
+        scenario's (a discrete filter holds only at its own T).
 
     Notes
     -----
@@ -56,10 +59,9 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True):
     and without maneuver it has no guarantee at all: Lemma 1 needs the
     closed-loop plant it was designed on (see notebook 04).
     """
-    system, meas = scenario.system(), scenario.measurement
-    if uses_input:
-        return LTIFilter(A_F, B_F, C_F, system, meas, name=name, input_matrix=scenario.input_matrix_design(), K=scenario.K)
-    return LTIFilter(A_F, B_F, C_F, system, meas, name=name)
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
+    return scenario.lti_filter(A_F, B_F, C_F, name=name, uses_input=uses_input, design_dt=design_dt)
 
 
 def make_estimator(name, scenario, **options):
@@ -78,12 +80,14 @@ def make_estimator(name, scenario, **options):
     as_choice("filter", name, FILTER_NAMES)
     if name in ("published", "published_closed_loop"):
         pub = published_filter()
-        return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"))
+        return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"),
+                                 design_dt=pub.dt)
     if name in ("designed", "designed_closed_loop", "designed_observer"):
         if name == "designed_observer":
             options.setdefault("form", "observer")
         res = design_for_scenario(scenario, **options)
-        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=(name != "designed_closed_loop"))
+        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=(name != "designed_closed_loop"),
+                                 design_dt=res.dt)
     return build_ekf(scenario, known_input=(name == "ekf_known_input"), **options)
 
 

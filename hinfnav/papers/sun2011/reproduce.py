@@ -9,6 +9,7 @@ from tqdm import tqdm
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
+from ...core.progress import bar_disabled
 from ...metrics.errors import rms_per_run
 from .constants import CITATION
 from .designs import design_for_scenario
@@ -84,7 +85,7 @@ def execute_notebooks(out_dir, timeout=900):
     if not nb_dir.is_dir():
         raise InputError(f"--notebooks needs the repository's notebooks/ folder next to the package; not found at {nb_dir}")
     written = []
-    for path in tqdm(sorted(nb_dir.glob("[0-9][0-9]_*.ipynb")), desc="notebooks", unit="nb"):
+    for path in tqdm(sorted(nb_dir.glob("[0-9][0-9]_*.ipynb")), disable=bar_disabled(True), desc="notebooks", unit="nb"):
         nb = nbformat.read(path, as_version=4)
         NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(nb_dir)}}).execute()
         target = Path(out_dir) / path.name
@@ -123,7 +124,7 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
     f7 = fig7_result(scenario, seed=seed)
     figs = {"fig2": fig2(runs_), "fig3": fig3(runs_), "fig4": fig4(runs_), "fig5": fig5(runs_), "fig6": fig6(runs_),
             "fig7": fig7(f7)}
-    for name, fig in tqdm(figs.items(), disable=not progress, desc="figures", unit="fig"):
+    for name, fig in tqdm(figs.items(), disable=bar_disabled(progress), desc="figures", unit="fig"):
         _save(fig, out, name)
     summary = to_json(_summary(tab, designed, observer, f7, scenario))
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

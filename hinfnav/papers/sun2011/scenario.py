@@ -14,8 +14,10 @@ import numpy as np
 
 from ...control.feedback import LinearFeedback
 from ...core.exceptions import InputError
-from ...core.linalg import discretize
+from ...core.linalg import discretize, spectral_radius
 from ...core.validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real, as_vector
+from ...design.result import SynthesisResult
+from ...estimators.lti import LTIFilter
 from ...sim.truth import TruthModel
 from ...systems.hill import (
     delta_A1,
@@ -224,6 +226,41 @@ class Scenario:
             raise InputError(f"maneuver must be True or False; got {maneuver!r}")
         return LinearFeedback(self.K, source=source, name="orbit maneuver u = Kx (3)") if maneuver else None
 
+    def lti_filter(self, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):
+        """The filter (12) designed on this scenario's closed loop, as an estimator.
+
+        ``uses_input=True`` tells it the applied thrust through
+        ``C_F⁻¹ T G₀ (u − K ẑ)``; False runs (12) verbatim, assuming u = K x.
+        ``design_dt`` (s) is checked against ``dt``: a discrete filter only holds
+        at the sampling time it was designed for.
+        """
+        if design_dt is not None and abs(float(design_dt) - self.dt) > 1e-12 * self.dt:
+            raise InputError(
+                f"filter {name!r} was designed for sampling time T = {float(design_dt):g} s but the scenario has "
+                f"dt = {self.dt:g} s: a discrete filter only holds at its own T (design one at this T, e.g. "
+                "filter 'designed')"
+            )
+        system, meas = self.system(), self.measurement
+        if uses_input:
+            return LTIFilter(A_F, B_F, C_F, system, meas, name=name, input_matrix=self.input_matrix_design(), K=self.K)
+        return LTIFilter(A_F, B_F, C_F, system, meas, name=name)
+
+    def estimator_from_design(self, design, *, verbatim=False, name="design"):
+        """An estimator from a :class:`~hinfnav.design.SynthesisResult` designed for this scenario.
+
+        Parameters
+        ----------
+        design : SynthesisResult
+        verbatim : bool
+            Run (12) exactly as designed, assuming u = K x (what Table 1 does
+            with maneuver); default: told the applied thrust.
+        name : str
+        """
+        if not isinstance(design, SynthesisResult):
+            raise InputError(f"design must be a hinfnav SynthesisResult; got {type(design).__name__}")
+        dt = None if design.dt is True else design.dt
+        return self.lti_filter(design.A_F, design.B_F, design.C_F, name=name, uses_input=not verbatim, design_dt=dt)
+
     def truth_model(self, maneuver=True, delta=0.0, discretization="exact"):
         """What the simulation layer needs: system, measurement, x₀, length and the law on the true state.
 
@@ -244,8 +281,16 @@ class Scenario:
         delta = as_real("delta", delta)
         as_choice("discretization", discretization, DISCRETIZATIONS)
         settings = {"maneuver": bool(maneuver), "delta": delta, "discretization": discretization}
-        return TruthModel(self.system(delta, discretization), self.measurement, self.x0, self.n_steps,
-                          self.controller(bool(maneuver)), settings)
+        system = self.system(delta, discretization)
+        if maneuver:
+            rho = spectral_radius(system.transition_matrix(self.K))
+            if not rho < 1.0:
+                raise InputError(
+                    f"the closed loop u = K x is unstable at delta = {delta:g} (spectral radius {rho:.6g} >= 1 with "
+                    f"this K and T = {self.dt:g} s): the true state would diverge. The paper's K keeps the loop "
+                    "stable for delta up to about 376; check delta and K"
+                )
+        return TruthModel(system, self.measurement, self.x0, self.n_steps, self.controller(bool(maneuver)), settings)
 
 
 def paper_scenario(**changes):

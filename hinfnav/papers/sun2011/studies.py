@@ -12,6 +12,7 @@ from ...analysis.observer import observer_form
 from ...core.exceptions import InputError
 from ...core.linalg import spectral_radius
 from ...core.validation import as_choice
+from ...core.progress import bar_disabled
 from ...metrics.errors import axes_rms, max_error, rms_error, rms_per_run
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth
@@ -125,7 +126,7 @@ def robustness_table(scenario=None, *, deltas=(0.0, 1.0), noises=("gaussian", "c
     scenario = Scenario() if scenario is None else scenario
     rows = []
     combos = [(f, d, n) for f in filters for d in deltas for n in noises]
-    for f, d, n in tqdm(combos, disable=not progress, desc="robustness", unit="case"):
+    for f, d, n in tqdm(combos, disable=bar_disabled(progress), desc="robustness", unit="case"):
         res = simulate(scenario, f, maneuver=maneuver, delta=d, noise=n, runs=runs, seed=seed)
         per = rms_per_run(res.error, res.t, scenario.rms_window_s)
         pos, vel = pos_vel(np.sqrt(np.mean(per**2, axis=0)), res.state)

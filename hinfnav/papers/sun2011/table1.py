@@ -23,6 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.validation import as_int_at_least
+from ...core.progress import bar_disabled
 from ...metrics.errors import axes_rms, rms_per_run
 from ...sim.montecarlo import run_estimator
 from ...sim.truth import simulate_truth
@@ -143,7 +144,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     win = scenario.rms_window_s
     cells, ekf_windows, klim = {}, {}, {}
     total = len(CASES) * len(_estimators(scenario, designed, True, observer))
-    with tqdm(total=total, disable=not progress, desc="Table 1", unit="filter") as bar:
+    with tqdm(total=total, disable=bar_disabled(progress), desc="Table 1", unit="filter") as bar:
         for case, maneuver in CASES.items():
             truth = simulate_truth(scenario.truth_model(maneuver=maneuver), runs=runs, seed=seed)
             cells[case] = {}

@@ -1,0 +1,90 @@
+"""Fixtures shared by the test files: the paper's scenario, a short one, random test systems.
+
+The scenarios are immutable (frozen dataclasses with read-only arrays), so one
+instance serves the whole session.
+"""
+
+import control
+import numpy as np
+import pytest
+
+from hinfnav.core import spectral_radius
+from hinfnav.metrics import rms_per_run
+from hinfnav.papers.sun2011 import Scenario
+
+#: Length and error window of the short scenario (600 steps of 0.1 s).
+SHORT_DURATION_S = 60.0
+SHORT_WINDOW_S = (10.0, 60.0)
+
+
+@pytest.fixture(scope="session")
+def scenario():
+    """The paper's scenario (Section 4): T = 0.1 s, 1000 s, RMS window 100–1000 s."""
+    return Scenario()
+
+
+@pytest.fixture(scope="session")
+def short_scenario():
+    """The paper's scenario cut to 60 s (RMS window 10–60 s), for fast structural checks."""
+    return Scenario(duration_s=SHORT_DURATION_S, rms_window_s=SHORT_WINDOW_S)
+
+
+@pytest.fixture(scope="session")
+def make_short_scenario():
+    """``make(**changes)``: the short scenario with some settings changed (e.g. ``B=0``)."""
+
+    def make(**changes):
+        return Scenario(duration_s=SHORT_DURATION_S, rms_window_s=SHORT_WINDOW_S, **changes)
+
+    return make
+
+
+def _random_stable(rng, n, m, p, rho):
+    """A random discrete system with spectral radius rho (built here, not by control.drss)."""
+    A = rng.standard_normal((n, n))
+    A *= rho / spectral_radius(A)
+    return control.ss(A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), np.zeros((p, m)), True)
+
+
+@pytest.fixture(scope="session")
+def random_stable():
+    """``make(rng, n, m, p, rho)``: a random discrete ``control.StateSpace`` with spectral radius rho."""
+    return _random_stable
+
+
+def _random_uncertain(rng, n=3, p=2, m=2, q=2, l=2, r=2, rho=0.8, size=0.1):
+    """Random (A, B, C, D, L, H, E): ρ(A) = rho, ‖H‖₂ = ‖E‖₂ = √size."""
+    A = rng.standard_normal((n, n))
+    A *= rho / spectral_radius(A)
+    B, C, D, L = (rng.standard_normal(s) for s in [(n, p), (m, n), (m, q), (l, n)])
+    H = rng.standard_normal((n, r))
+    E = rng.standard_normal((r, n))
+    H *= np.sqrt(size) / np.linalg.norm(H, 2)
+    E *= np.sqrt(size) / np.linalg.norm(E, 2)
+    return A, B, C, D, L, H, E
+
+
+@pytest.fixture(scope="session")
+def random_uncertain():
+    """``make(rng, n=3, p=2, m=2, q=2, l=2, r=2, rho=0.8, size=0.1)``: random uncertain plant matrices."""
+    return _random_uncertain
+
+
+def _assert_rms_matches(error, t, window, sigma, n_se=4.0):
+    """Per-component RMS over runs and window vs sigma, within n_se standard errors.
+
+    The standard error is that of the mean over runs of the per-run mean
+    square (runs are independent; samples within a run are not), carried to
+    the RMS by the delta method. Returns ``(rms, se)``.
+    """
+    per_run = rms_per_run(error, t, window) ** 2
+    rms = np.sqrt(per_run.mean(axis=0))
+    se = per_run.std(axis=0, ddof=1) / np.sqrt(per_run.shape[0]) / (2 * rms)
+    assert np.all(np.abs(rms - sigma) < n_se * se), (rms, sigma, se)
+    return rms, se
+
+
+@pytest.fixture(scope="session")
+def assert_rms_matches():
+    """``check(error, t, window, sigma, n_se=4.0)``: Monte Carlo RMS against a predicted std (see above)."""
+    return _assert_rms_matches
