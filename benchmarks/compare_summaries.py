@@ -8,7 +8,9 @@ Prints every numeric leaf whose relative difference exceeds ``rtol`` (and keys
 present in one file only), then the largest relative difference; exits 1 if
 anything differs. Used to check that a refactoring leaves every reproduced
 number of ``python -m hinfnav reproduce --seed 0`` unchanged (issue 7: 1e-9).
-Fields that record time or provenance (``*_time_s``, ``provenance``) are skipped.
+Fields that record time or provenance (``*_time_s``, ``provenance``) are skipped;
+fields only in NEW are listed as added (a later version may add fields), fields
+only in OLD count as differences.
 """
 
 import argparse
@@ -32,12 +34,15 @@ def leaves(obj, prefix=""):
 
 def compare(old, new, rtol):
     a, b = dict(leaves(old)), dict(leaves(new))
-    problems, worst = [], 0.0
+    problems, worst, added = [], 0.0, []
     for key in sorted(set(a) | set(b)):
         if any(s in key for s in SKIP):
             continue
-        if key not in a or key not in b:
-            problems.append(f"{key}: only in {'new' if key not in a else 'old'}")
+        if key not in a:
+            added.append(key)
+            continue
+        if key not in b:
+            problems.append(f"{key}: only in old")
             continue
         x, y = a[key], b[key]
         if isinstance(x, (int, float)) and isinstance(y, (int, float)) and not isinstance(x, bool):
@@ -49,7 +54,7 @@ def compare(old, new, rtol):
                 problems.append(f"{key}: {x!r} vs {y!r} (relative {rel:.3g})")
         elif x != y:
             problems.append(f"{key}: {x!r} vs {y!r}")
-    return problems, worst, len(a)
+    return problems, worst, len(a), added
 
 
 def main(argv=None):
@@ -62,10 +67,11 @@ def main(argv=None):
         old = json.load(fh)
     with open(args.new) as fh:
         new = json.load(fh)
-    problems, worst, n = compare(old, new, args.rtol)
+    problems, worst, n, added = compare(old, new, args.rtol)
     for line in problems:
         print(line)
-    print(f"{n} leaves compared; largest relative difference {worst:.3g}; {len(problems)} differ beyond {args.rtol:g}")
+    print(f"{n} leaves compared; largest relative difference {worst:.3g}; {len(problems)} differ beyond {args.rtol:g}; "
+          f"{len(added)} fields added")
     return 1 if problems else 0
 
 

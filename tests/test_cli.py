@@ -59,7 +59,7 @@ def test_simulate_table_output(capsys):
         (["simulate", "--noise", "pink"], "invalid choice: 'pink'"),
         (["simulate", "--delta", "inf"], "--delta must be finite"),
         (["simulate", "--delta", "-3"], "delta must be > -1"),
-        (["design", "--delta-bar", "-0.1"], "--delta-bar must be >= 0"),
+        (["design", "--delta-bar", "-0.1"], "--delta-bar must be a finite number >= 0"),
         (["reproduce", "--paper", "nope"], "invalid choice: 'nope'"),
     ],
 )

@@ -30,6 +30,6 @@ def test_reproduce_seed0_matches_the_numbers_before_the_reshaping(tmp_path):
         assert (tmp_path / name).is_file() and (tmp_path / name).stat().st_size > 0, name
     new = json.loads((tmp_path / "summary.json").read_text())
     old = json.loads(EXPECTED.read_text())
-    problems, worst, n = _comparator()(old, new, 1e-9)
+    problems, worst, n, _ = _comparator()(old, new, 1e-9)
     assert n > 250
     assert not problems, "\n".join(problems[:20])

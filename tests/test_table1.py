@@ -10,8 +10,11 @@ ours must sit at that limit (within 3 %, Monte Carlo) and above the paper's.
 Our numbers: single run 0 and 100-run mean of ``table1(runs=100, seed=0)``.
 """
 
+import json
+
 import pytest
 
+from hinfnav.cli import main
 from hinfnav.papers.sun2011 import PAPER_TABLE1, Scenario, table1
 
 # (case, filter key in our table, paper column, quantity, half-unit of the paper's last digit, verdict)
@@ -56,3 +59,27 @@ def test_table1_cell(tab, case, key, paper_col, quantity, half_unit, verdict):
         assert paper is None
         limit = _kalman(tab, case, quantity)
         assert mc > 5 * limit, f"ours {mc:.4g} vs Kalman limit {limit:.4g}"
+
+
+@pytest.fixture(scope="module")
+def small_tab():
+    return table1(Scenario(), runs=6, seed=3)
+
+
+@pytest.mark.parametrize("case", ["no_maneuver", "maneuver"])
+@pytest.mark.parametrize("key", ["ekf", "ekf_known_input", "hinf_published", "hinf_designed", "hinf_observer"])
+def test_each_row_is_reproduced_by_the_command_it_names(small_tab, case, key, capsys):
+    # identity: the command runs the same filter on the same seeded truth, so the numbers are equal
+    cell = small_tab.cells[case][key]
+    argv = cell["cli"].split()[3:]  # drop "python -m hinfnav"
+    assert main(argv) == 0
+    rep = json.loads(capsys.readouterr().out)
+    for q in ("pos_m", "vel_mps"):
+        assert rep[f"cell_{q}"] == pytest.approx(cell[q], rel=1e-12)
+        assert rep[f"cell_mc_mean_{q}"] == pytest.approx(cell[f"mc_mean_{q}"], rel=1e-12)
+        assert rep[f"cell_mc_ci95_{q}"] == pytest.approx(cell[f"mc_ci95_{q}"], rel=1e-12)
+
+
+def test_designed_filter_bias_without_maneuver_is_footnoted(small_tab):
+    assert "observer form" in small_tab.cells["no_maneuver"]["hinf_designed"]["note"]
+    assert small_tab.cells["no_maneuver"]["hinf_designed"]["vel_mps"] > 5.0  # the 15 m/s bias the note explains

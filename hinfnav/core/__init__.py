@@ -1,7 +1,11 @@
 """Core layer: exceptions, input validation and small linear-algebra helpers.
 
-Imports nothing from the rest of the package.
+Imports nothing from the rest of the package. The linear-algebra helpers
+(which load scipy) are loaded on first use, so that the command line, which
+needs only the exceptions, starts fast.
 """
+
+import importlib
 
 from .exceptions import (
     CertificationError,
@@ -11,8 +15,18 @@ from .exceptions import (
     SynthesisError,
     UnstablePlantError,
 )
-from .linalg import as_covariance, discretize, spectral_radius, sym
 from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, as_positive, as_real, as_vector
+
+_LAZY = {"as_covariance": "linalg", "discretize": "linalg", "spectral_radius": "linalg", "sym": "linalg"}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'hinfnav.core' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "HinfnavError",

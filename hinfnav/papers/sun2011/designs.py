@@ -19,6 +19,7 @@ from ...analysis.observer import observer_form
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_nonnegative
 from ...core.progress import bar_disabled
+from ...core.provenance import provenance
 from ...design import io as design_io
 from ...design.robust_hinf import synthesize
 from ...design.samples import SampleSet
@@ -35,6 +36,7 @@ __all__ = [
     "GammaSweep",
     "gamma_sweep",
     "design_report",
+    "design_report_from",
     "format_design_report",
     "compare_with_published",
     "save_design",
@@ -222,7 +224,11 @@ def design_report(delta_bar, solver=None, scenario=None, form="general"):
         ``method``, ``solve_time_s``, ``total_time_s``, ``dt``, ``A_F``,
         ``B_F``, ``C_F`` (nested lists), ``deltas_checked``, ``attempts``.
     """
-    res = design_for_scenario(scenario, delta_bar, solver=solver, form=form)
+    return design_report_from(design_for_scenario(scenario, delta_bar, solver=solver, form=form))
+
+
+def design_report_from(res):
+    """The JSON-ready report of :func:`design_report` for a design already made (with provenance)."""
     return {
         "delta_bar": float(res.delta_bar),
         "form": res.form,
@@ -241,6 +247,7 @@ def design_report(delta_bar, solver=None, scenario=None, form="general"):
         "C_F": res.C_F.tolist(),
         "deltas_checked": [float(d) for d in res.deltas],
         "attempts": list(res.attempts),
+        "provenance": provenance(),
     }
 
 

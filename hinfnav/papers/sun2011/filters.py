@@ -13,6 +13,7 @@ name                       estimator
 ``designed_observer``      the robust filter constrained to observer form
                            (``form="observer"``, an extension: its error does
                            not depend on the trajectory), told the thrust
+``designed_observer_closed_loop``  the same run exactly as (12) (Table 1 with maneuver)
 ``ekf``                    the EKF of :mod:`hinfnav.papers.sun2011.ekf`, as the paper describes
                            it (does not know the control law)
 ``ekf_known_input``        the EKF told the applied thrust
@@ -27,9 +28,13 @@ from .designs import design_for_scenario
 from .ekf import build_ekf
 from .scenario import Scenario
 
-__all__ = ["FILTER_NAMES", "make_estimator", "lti_from_matrices"]
+__all__ = ["FILTER_NAMES", "VERBATIM", "make_estimator", "lti_from_matrices"]
 
-FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer", "ekf", "ekf_known_input")
+FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
+                "designed_observer_closed_loop", "ekf", "ekf_known_input")
+
+#: Filters run exactly as (12), assuming u = K x (the others are told the applied thrust).
+VERBATIM = ("published_closed_loop", "designed_closed_loop", "designed_observer_closed_loop")
 
 
 def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True, design_dt=None):
@@ -82,11 +87,11 @@ def make_estimator(name, scenario, **options):
         pub = published_filter()
         return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"),
                                  design_dt=pub.dt)
-    if name in ("designed", "designed_closed_loop", "designed_observer"):
-        if name == "designed_observer":
+    if name.startswith("designed"):
+        if name.startswith("designed_observer"):
             options.setdefault("form", "observer")
         res = design_for_scenario(scenario, **options)
-        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=(name != "designed_closed_loop"),
+        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=name not in VERBATIM,
                                  design_dt=res.dt)
     return build_ekf(scenario, known_input=(name == "ekf_known_input"), **options)
 
@@ -97,6 +102,7 @@ _DESCRIPTIONS = {
     "designed": "robust H-inf filter designed here (Corollary 1), told the applied thrust",
     "designed_closed_loop": "the designed filter run verbatim as (12)",
     "designed_observer": "robust H-inf filter constrained to observer form (extension), told the thrust",
+    "designed_observer_closed_loop": "the observer-form filter run verbatim as (12)",
     "ekf": "EKF that does not know the control law (Sun 2011's comparison)",
     "ekf_known_input": "EKF told the applied thrust",
 }

@@ -16,6 +16,8 @@ Conventions (the paper does not state them; see the notebooks for why):
 """
 
 import csv
+import json
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -33,7 +35,8 @@ from .filters import lti_from_matrices, make_estimator
 from .limits import kalman_limit
 from .scenario import Scenario
 
-__all__ = ["TABLE_FILTERS", "CASES", "Table1", "table1", "table1_rows", "format_table1", "write_table1", "case_cell"]
+__all__ = ["TABLE_FILTERS", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows", "format_table1",
+           "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
 
 #: Filters of the reproduced table: key -> (label, builder name)
 TABLE_FILTERS = {
@@ -90,18 +93,25 @@ class Table1:
     settings: dict = field(default_factory=dict)
 
 
-def case_cell(result, t, window):
-    """One Table 1 cell: single-run and Monte Carlo position and velocity RMS of a result."""
+def cell_values(result, t, window):
+    """Per-run position and velocity statistics of a result: ``(pos_run, vel_run, pos_axes, vel_axes)``.
+
+    ``pos_run``/``vel_run`` (runs,): RMS over x, y, z of each run's per-axis RMS
+    over ``window``; ``pos_axes``/``vel_axes`` (runs, 3): the per-axis values.
+    """
     per_run = rms_per_run(result.error, t, window)  # (runs, n)
     state = result.state
     pos_axes, vel_axes = state.select(per_run, "position"), state.select(per_run, "velocity")
-    pos_run = np.sqrt(np.mean(pos_axes**2, axis=1))
-    vel_run = np.sqrt(np.mean(vel_axes**2, axis=1))
+    return np.sqrt(np.mean(pos_axes**2, axis=1)), np.sqrt(np.mean(vel_axes**2, axis=1)), pos_axes, vel_axes
+
+
+def cell_from_values(pos_run, vel_run, pos_axes0, vel_axes0):
+    """One Table 1 cell from the per-run values (run 0 is the single run the paper shows)."""
     out = {
         "pos_m": float(pos_run[0]),
         "vel_mps": float(vel_run[0]),
-        "pos_axes_m": [float(v) for v in pos_axes[0]],
-        "vel_axes_mps": [float(v) for v in vel_axes[0]],
+        "pos_axes_m": [float(v) for v in pos_axes0],
+        "vel_axes_mps": [float(v) for v in vel_axes0],
     }
     for key, vals in (("pos_m", pos_run), ("vel_mps", vel_run)):
         n = vals.size
@@ -113,7 +123,42 @@ def case_cell(result, t, window):
     return out
 
 
-def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False):
+def case_cell(result, t, window):
+    """One Table 1 cell: single-run and Monte Carlo position and velocity RMS of a result."""
+    pos_run, vel_run, pos_axes, vel_axes = cell_values(result, t, window)
+    return cell_from_values(pos_run, vel_run, pos_axes[0], vel_axes[0])
+
+
+#: The ``simulate --filter`` name that reproduces each row, per case (maneuver: the H∞
+#: filters run verbatim as (12); no maneuver: told the applied thrust).
+ROW_FILTERS = {
+    "ekf": {False: "ekf", True: "ekf"},
+    "ekf_known_input": {False: "ekf_known_input", True: "ekf_known_input"},
+    "hinf_published": {False: "published", True: "published_closed_loop"},
+    "hinf_designed": {False: "designed", True: "designed_closed_loop"},
+    "hinf_observer": {False: "designed_observer", True: "designed_observer_closed_loop"},
+}
+
+#: Footnotes of the reproduced table.
+FOOTNOTES = {
+    ("no_maneuver", "hinf_designed"): (
+        "biased: the LMI optimum is not in observer form, so the thrust correction C_F^-1 T G0 (u - K z) that "
+        "tells it u = 0 is not exact and its error follows the drifting free-motion state (15 m/s); the "
+        "observer-form filter below has no such bias"
+    ),
+}
+
+EKF_WINDOWS = (("0-500 s", (0.0, 500.0)), ("100-500 s", (100.0, 500.0)), ("500-1000 s", (500.0, 1000.0)))
+
+
+def row_command(key, maneuver, runs, seed):
+    """The command line that reproduces a row of the table (same seed, same numbers)."""
+    name = ROW_FILTERS[key][bool(maneuver)]
+    flag = "" if maneuver else " --no-maneuver"
+    return f"python -m hinfnav simulate --filter {name}{flag} --runs {runs} --seed {seed} --json"
+
+
+def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False, batch_size=100):
     """Compute the reproduced Table 1.
 
     Parameters
@@ -130,32 +175,55 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
         The δ̄ = 0.05 filter designed in observer form (an extension of the
         paper); designed here when None.
     progress : bool
+    batch_size : int
+        Runs simulated together; memory is that of one batch (about 50 MB per
+        100 runs), whatever ``runs``; the numbers do not depend on it.
 
     Returns
     -------
     Table1
+        Each filter cell also holds ``cli``, the command that reproduces it.
     """
     scenario = Scenario() if scenario is None else scenario
     runs = as_int_at_least("runs", runs, 1)
+    batch_size = as_int_at_least("batch_size", batch_size, 1)
     if designed is None:
         designed = design_for_scenario(scenario, delta_bar=0.05)
     if observer is None:
         observer = design_for_scenario(scenario, delta_bar=0.05, form="observer")
     win = scenario.rms_window_s
     cells, ekf_windows, klim = {}, {}, {}
-    total = len(CASES) * len(_estimators(scenario, designed, True, observer))
+    keys = list(_estimators(scenario, designed, True, observer))
+    total = len(CASES) * len(keys) * -(-runs // batch_size)
     with tqdm(total=total, disable=bar_disabled(progress), desc="Table 1", unit="filter") as bar:
         for case, maneuver in CASES.items():
-            truth = simulate_truth(scenario.truth_model(maneuver=maneuver), runs=runs, seed=seed)
+            model = scenario.truth_model(maneuver=maneuver)
+            ests = _estimators(scenario, designed, maneuver, observer)
+            values = {(key, w): [] for key in keys for w in ["main"] + [label for label, _ in EKF_WINDOWS]}
+            for start in range(0, runs, batch_size):
+                truth = simulate_truth(model, runs=min(batch_size, runs - start), seed=seed, first_run=start)
+                for key, est in ests.items():
+                    res = run_estimator(est, truth, scenario.xhat0)
+                    values[key, "main"].append(cell_values(res, truth.t, win))
+                    if case == "maneuver" and key == "ekf":
+                        for label, w in EKF_WINDOWS:
+                            values[key, label].append(cell_values(res, truth.t, w))
+                    del res
+                    bar.update(1)
+                del truth
             cells[case] = {}
-            for key, est in _estimators(scenario, designed, maneuver, observer).items():
-                res = run_estimator(est, truth, scenario.xhat0)
-                cells[case][key] = case_cell(res, truth.t, win)
-                if case == "maneuver" and key == "ekf":
-                    for label, w in (("0-500 s", (0.0, 500.0)), ("100-500 s", (100.0, 500.0)), ("500-1000 s", (500.0, 1000.0))):
-                        ekf_windows[label] = case_cell(res, truth.t, w)
-                del res
-                bar.update(1)
+            for (key, w), parts in values.items():
+                if not parts:
+                    continue
+                joined = [np.concatenate([p[i] for p in parts]) for i in range(4)]
+                cell = cell_from_values(joined[0], joined[1], joined[2][0], joined[3][0])
+                if w == "main":
+                    cell["cli"] = row_command(key, maneuver, runs, seed)
+                    if (case, key) in FOOTNOTES:
+                        cell["note"] = FOOTNOTES[case, key]
+                    cells[case][key] = cell
+                else:
+                    ekf_windows[w] = cell
             for key, paper_key in (("paper_ekf", "ekf"), ("paper_hinf", "hinf")):
                 cells[case][key] = dict(PAPER_TABLE1[case][paper_key])
             klim[case] = kalman_limit(scenario, maneuver=maneuver).as_dict()
@@ -185,24 +253,48 @@ def _kl_axes(kl, predicted=False):
     return axes_rms(kl["pos_m" + suffix]), axes_rms(kl["vel_mps" + suffix])
 
 
+#: Short filter labels for the terminal table (at most 100 columns).
+SHORT_LABELS = {
+    "paper_ekf": "paper: EKF",
+    "paper_hinf": "paper: H∞",
+    "ekf": "EKF, u unknown (paper)",
+    "ekf_known_input": "EKF, knows u",
+    "hinf_published": "H∞ published",
+    "hinf_designed": "H∞ designed here",
+    "hinf_observer": "H∞ observer form",
+    "kalman": "Kalman limit, filtered",
+    "kalman_predicted": "Kalman limit, predicted",
+}
+
+
 def table1_rows(tab):
-    """Rows (list of dicts) of the reproduced table, paper values beside them."""
+    """Rows (list of dicts) of the reproduced table, paper values beside them.
+
+    Each row has ``case``, ``key``, ``filter`` (label), ``pos_m``, ``vel_mps``
+    (single run), and where they apply the Monte Carlo means and intervals,
+    ``cli`` (the command that reproduces the row) and ``note`` (a footnote).
+    """
     rows = []
     for case in CASES:
         for key, label in [("paper_ekf", "paper: EKF"), ("paper_hinf", "paper: H∞")] + list(TABLE_FILTERS.items()):
             c = tab.cells[case].get(key)
             if c is None:
                 continue
-            row = {"case": case.replace("_", " "), "filter": label, "pos_m": c["pos_m"], "vel_mps": c["vel_mps"]}
+            row = {"case": case.replace("_", " "), "key": key, "filter": label, "pos_m": c["pos_m"],
+                   "vel_mps": c["vel_mps"]}
             if "mc_mean_pos_m" in c:
                 row.update(
                     mc_pos_m=c["mc_mean_pos_m"], mc_pos_ci95=c["mc_ci95_pos_m"],
                     mc_vel_mps=c["mc_mean_vel_mps"], mc_vel_ci95=c["mc_ci95_vel_mps"],
                 )
+            for extra in ("cli", "note"):
+                if extra in c:
+                    row[extra] = c[extra]
             rows.append(row)
-        for predicted, label in ((False, "Kalman limit, filtered (uses y(k))"), (True, "Kalman limit, predicted (y up to k-1, like (12))")):
+        for predicted, key, label in ((False, "kalman", "Kalman limit, filtered (uses y(k))"),
+                                      (True, "kalman_predicted", "Kalman limit, predicted (y up to k-1, like (12))")):
             kp, kv = _kl_axes(tab.kalman_limit[case], predicted)
-            rows.append({"case": case.replace("_", " "), "filter": label, "pos_m": kp, "vel_mps": kv})
+            rows.append({"case": case.replace("_", " "), "key": key, "filter": label, "pos_m": kp, "vel_mps": kv})
     return rows
 
 
@@ -214,39 +306,67 @@ def _fmt(v, digits=3):
     return f"{v:.{digits}g}"
 
 
+def _pm(mean, ci):
+    return f"{mean:.3g} ± {0.5 * (ci[1] - ci[0]):.1g}"
+
+
 def format_table1(tab, markdown=False):
-    """Paper-vs-reproduced Table 1 as text (plain or Markdown)."""
+    """Paper-vs-reproduced Table 1 as text (plain, at most 100 columns, or Markdown with the commands)."""
     rows = table1_rows(tab)
     runs = tab.settings.get("runs")
-    head = ["case", "filter", "pos (m), 1 run", "vel (m/s), 1 run", f"pos (m), mean of {runs} [95% CI]",
-            f"vel (m/s), mean of {runs} [95% CI]"]
+    notes = [r for r in rows if "note" in r]
+    mark = lambda r: f" [{notes.index(r) + 1}]" if r in notes else ""  # noqa: E731
+    if markdown:
+        head = ["case", "filter", "pos (m), 1 run", "vel (m/s), 1 run", f"pos (m), mean of {runs} [95% CI]",
+                f"vel (m/s), mean of {runs} [95% CI]", "reproduce with"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for r in rows:
+            mc_p = f"{_fmt(r['mc_pos_m'])} {_fmt(r['mc_pos_ci95'])}" if "mc_pos_m" in r else ""
+            mc_v = f"{_fmt(r['mc_vel_mps'])} {_fmt(r['mc_vel_ci95'])}" if "mc_vel_mps" in r else ""
+            cli = f"`{r['cli']}`" if "cli" in r else ""
+            lines.append("| " + " | ".join([r["case"], r["filter"] + mark(r), _fmt(r["pos_m"]), _fmt(r["vel_mps"]),
+                                            mc_p, mc_v, cli]) + " |")
+        lines += [""] + [f"[{i + 1}] {r['filter']}, {r['case']}: {r['note']}." for i, r in enumerate(notes)]
+        return "\n".join(lines)
+    head = ["case", "filter", "pos m", "vel m/s", f"pos m, {runs} runs", f"vel m/s, {runs} runs"]
     body = []
     for r in rows:
-        mc_p = f"{_fmt(r['mc_pos_m'])} {_fmt(r['mc_pos_ci95'])}" if "mc_pos_m" in r else ""
-        mc_v = f"{_fmt(r['mc_vel_mps'])} {_fmt(r['mc_vel_ci95'])}" if "mc_vel_mps" in r else ""
-        body.append([r["case"], r["filter"], _fmt(r["pos_m"]), _fmt(r["vel_mps"]), mc_p, mc_v])
-    if markdown:
-        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        lines += ["| " + " | ".join(b) + " |" for b in body]
-        return "\n".join(lines)
+        mc_p = _pm(r["mc_pos_m"], r["mc_pos_ci95"]) if "mc_pos_m" in r else ""
+        mc_v = _pm(r["mc_vel_mps"], r["mc_vel_ci95"]) if "mc_vel_mps" in r else ""
+        body.append([r["case"], SHORT_LABELS[r["key"]] + mark(r), _fmt(r["pos_m"]), _fmt(r["vel_mps"]), mc_p, mc_v])
     widths = [max(len(str(x)) for x in col) for col in zip(head, *body)]
-    fmt = lambda cells: "  ".join(str(c).ljust(w) for c, w in zip(cells, widths))  # noqa: E731
-    return "\n".join([fmt(head), fmt(["-" * w for w in widths])] + [fmt(b) for b in body])
+    fmt = lambda cells: "  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip()  # noqa: E731
+    out = [fmt(head), fmt(["-" * w for w in widths])] + [fmt(b) for b in body]
+    out += [f"[{i + 1}] {r['note']}" for i, r in enumerate(notes)]
+    return "\n".join(_wrap(line, 100) for line in out)
 
 
-def write_table1(tab, out_dir):
-    """Write ``table1.csv`` and ``table1.md`` into ``out_dir``; return their paths."""
+def _wrap(line, width):
+    if len(line) <= width:
+        return line
+    return "\n".join(textwrap.wrap(line, width, subsequent_indent="    "))
+
+
+def write_table1(tab, out_dir, provenance=None):
+    """Write ``table1.csv`` and ``table1.md`` into ``out_dir``; return their paths.
+
+    The CSV starts with ``#`` comment lines holding the provenance (read it
+    with ``pandas.read_csv(path, comment="#")``); the Markdown ends with it.
+    """
     out_dir = Path(out_dir)
     rows = table1_rows(tab)
+    prov = provenance or {}
     csv_path = out_dir / "table1.csv"
     with open(csv_path, "w", newline="") as fh:
+        for k, v in prov.items():
+            fh.write(f"# {k}: {json.dumps(v)}\n")
         w = csv.writer(fh)
         w.writerow(["case", "filter", "pos_m_single_run", "vel_mps_single_run", "pos_m_mc_mean", "pos_m_mc_ci95_lo",
-                    "pos_m_mc_ci95_hi", "vel_mps_mc_mean", "vel_mps_mc_ci95_lo", "vel_mps_mc_ci95_hi"])
+                    "pos_m_mc_ci95_hi", "vel_mps_mc_mean", "vel_mps_mc_ci95_lo", "vel_mps_mc_ci95_hi", "cli", "note"])
         for r in rows:
             mc = [r.get("mc_pos_m"), *(r.get("mc_pos_ci95") or [None, None]), r.get("mc_vel_mps"),
                   *(r.get("mc_vel_ci95") or [None, None])]
-            w.writerow([r["case"], r["filter"], r["pos_m"], r["vel_mps"], *mc])
+            w.writerow([r["case"], r["filter"], r["pos_m"], r["vel_mps"], *mc, r.get("cli", ""), r.get("note", "")])
     md_path = out_dir / "table1.md"
     md_path.write_text(
         "# Table 1: relative navigation accuracy, paper vs reproduced\n\n"
@@ -254,7 +374,6 @@ def write_table1(tab, out_dir):
         + "\n\nError measure: " + tab.settings["error_measure"] + ".\n"
         + f"Window {tab.settings['window_s'][0]:g}-{tab.settings['window_s'][1]:g} s, T = {tab.settings['dt_s']:g} s, "
         + f"{tab.settings['runs']} Monte Carlo runs, seed {tab.settings['seed']}.\n"
+        + ("\nProvenance: " + json.dumps(prov) + "\n" if prov else "")
     )
     return csv_path, md_path
-
-
