@@ -1,14 +1,17 @@
 """Figs 2–7 of Sun et al. (2011), reproduced: one function per figure, each returning a Figure."""
 
+import textwrap
+
 import numpy as np
 
+from ...core.exceptions import InputError
 from ...plotting.errors import new_figure, plot_errors, plot_inputs
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth
 from .filters import make_estimator
 from .scenario import Scenario
 
-__all__ = ["figure_errors", "paper_runs", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig7_result", "plot_thrust"]
+__all__ = ["FIGURE_SIZES", "figure_errors", "paper_runs", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig7_result", "plot_thrust"]
 
 
 def plot_thrust(result, *, ax, run=0):
@@ -19,23 +22,76 @@ def plot_thrust(result, *, ax, run=0):
 
 
 
-def figure_errors(result, title, *, run=0, t_zoom_from=5.0):
+#: Figure sizes (width, height) in inches: a journal column, a full page width, and the screen default.
+FIGURE_SIZES = {"single": (3.5, 3.2), "double": (7.0, 4.2), "default": (12.0, 5.5)}
+_FONT = {"single": 6.5, "double": 8.0, "default": None}
+
+
+def _fonts(fig, size):
+    """Readable fonts at a journal size (set on the artists: no global matplotlib state)."""
+    pt = _FONT[size]
+    if pt is None:
+        return
+    for ax in fig.axes:
+        ax.tick_params(labelsize=pt)
+        ax.xaxis.label.set_size(pt)
+        ax.yaxis.label.set_size(pt)
+        ax.title.set_size(pt)
+        if ax.get_legend() is not None:
+            for t in ax.get_legend().get_texts():
+                t.set_size(pt)
+    for t in fig.texts:
+        t.set_size(pt - 1)
+    if fig._suptitle is not None:
+        fig._suptitle.set_size(pt + 0.5)
+        fig._suptitle.set_text(textwrap.fill(fig._suptitle.get_text(), 48 if size == "single" else 100))
+    grid = np.asarray(fig.axes).reshape(2, -1) if len(fig.axes) % 2 == 0 else None
+    if grid is not None:
+        for ax in grid[0]:
+            ax.set_xlabel("")
+
+
+def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default"):
     """Per-axis position and velocity errors of one run (the layout of Figs 2–5, 7).
 
     The y limits leave out the first ``t_zoom_from`` seconds (the 30–40 m
-    initial error), as the paper's figures do.
+    initial error), as the paper's figures do; a note under the figure says
+    what was clipped.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    title : str
+    run : int
+    t_zoom_from : float
+        Seconds left out of the y limits, s.
+    size : {"default", "single", "double"}
+        12 × 5.5 in (screen), 3.5 in (one journal column) or 7 in (full width).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
+    if size not in FIGURE_SIZES:
+        raise InputError(f"size must be one of {', '.join(FIGURE_SIZES)}; got {size!r}")
     state = result.state
-    fig, axes = new_figure(len(state.groups), max(len(i) for i in state.groups.values()), figsize=(12, 5.5))
+    fig, axes = new_figure(len(state.groups), max(len(i) for i in state.groups.values()), figsize=FIGURE_SIZES[size])
     m = result.t >= t_zoom_from
     err = result.error[run][m]
     lim = lambda a: 1.15 * max(np.max(np.abs(a)), 1e-6)  # noqa: E731
     ylims = {g: (-lim(state.select(err, g)), lim(state.select(err, g))) for g in state.groups}
     plot_errors(result, axes=axes, run=run, ylims=ylims, title=title)
+    if t_zoom_from > result.t[0]:
+        early = result.error[run][~m]
+        peak = {g: float(np.max(np.abs(state.select(early, g)))) for g in state.groups}
+        clipped = ", ".join(f"{g} up to {peak[g]:.3g} {state.group_unit(g)}" for g in state.groups)
+        note = f"y axes clipped: the first {t_zoom_from:g} s (initial error: {clipped}) lie outside"
+        wrapped = textwrap.fill(note, 70 if size == "single" else 160)
+        txt = fig.text(0.01, 0.005, wrapped, fontsize=7, color="0.35", ha="left", va="bottom")
+        txt.set_in_layout(False)
+        bottom = 0.03 * (1 + wrapped.count("\n")) * (2 if size == "single" else 1)
+        fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))  # (left, bottom, width, height)
+    _fonts(fig, size)
     return fig
 
 
@@ -57,31 +113,37 @@ def paper_runs(scenario=None, *, seed=0, progress=False):
     return out
 
 
-def fig2(runs):
+def fig2(runs, size="default"):
     """Fig 2: EKF errors without maneuver."""
-    return figure_errors(runs[("ekf", False)], "Fig 2 — EKF, no orbit maneuver: position (m) and velocity (m/s) errors")
+    return figure_errors(runs[("ekf", False)], "Fig 2 — EKF, no orbit maneuver: position (m) and velocity (m/s) errors", size=size)
 
 
-def fig3(runs):
+def fig3(runs, size="default"):
     """Fig 3: robust H∞ filter (published matrices) errors without maneuver."""
-    return figure_errors(runs[("hinf_published", False)], "Fig 3 — robust H∞ filter (published), no orbit maneuver")
+    return figure_errors(runs[("hinf_published", False)], "Fig 3 — robust H∞ filter (published), no orbit maneuver", size=size)
 
 
-def fig4(runs):
+def fig4(runs, size="default"):
     """Fig 4: EKF errors with maneuver; the paper's variant (control law unknown)
-    in colour, the variant that knows the thrust in grey."""
+    in colour, the variant that knows the thrust in grey; the dotted line at
+    500 s marks where the thrust has died away (Fig 6)."""
     res = runs[("ekf", True)]
-    fig = figure_errors(res, "Fig 4 — EKF with orbit maneuver: control law unknown (colour) vs known thrust (grey)")
+    fig = figure_errors(res, "Fig 4 — EKF with orbit maneuver: control law unknown (colour) vs known thrust (grey)",
+                        size=size)
     known = runs[("ekf_known_input", True)]
     for i, ax in enumerate(fig.axes[:6]):
         ax.plot(known.t, known.error[0, :, i], color="0.45", lw=0.6, zorder=3)
         ax.axvline(500.0, color="k", ls=":", lw=0.8)
+    ax0 = fig.axes[0]
+    ann = ax0.annotate("500 s" if size == "single" else "t = 500 s: thrust ≈ 0", xy=(500.0, 0.97), xycoords=("data", "axes fraction"), xytext=(3, 0),
+                       textcoords="offset points", fontsize=6 if size == "single" else 8, va="top", ha="left")
+    ann.set_in_layout(False)
     return fig
 
 
-def fig5(runs):
+def fig5(runs, size="default"):
     """Fig 5: robust H∞ filter (published matrices) errors with maneuver."""
-    return figure_errors(runs[("hinf_published", True)], "Fig 5 — robust H∞ filter (published), with orbit maneuver")
+    return figure_errors(runs[("hinf_published", True)], "Fig 5 — robust H∞ filter (published), with orbit maneuver", size=size)
 
 
 def fig6(runs):
@@ -98,9 +160,10 @@ def fig7_result(scenario=None, *, seed=0, delta=1.0, noise="mixture"):
     return simulate(scenario, "published", maneuver=True, delta=delta, noise=noise, runs=1, seed=seed)
 
 
-def fig7(result):
+def fig7(result, size="default"):
     """Fig 7: robust H∞ filter with δ = 1 and non-Gaussian (Gaussian-mixture) noise."""
     d = result.settings["delta"]
-    return figure_errors(result, f"Fig 7 — robust H∞ filter (published), δ = {d:g}, {result.settings['noise']} noise, with maneuver")
+    return figure_errors(result, f"Fig 7 — robust H∞ filter (published), δ = {d:g}, {result.settings['noise']} noise, "
+                                 "with maneuver", size=size)
 
 

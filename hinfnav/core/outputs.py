@@ -1,0 +1,116 @@
+"""Output folders written whole or not at all, and never by two processes at once.
+
+:func:`atomic_output_dir` checks the target before any work (an empty path, a
+file, a folder under a file, a folder that cannot be written, a folder holding
+files hinfnav did not write → a clear :class:`InputError`), takes a lock beside
+it (a second process writing into the same folder is refused), hands out a
+temporary folder beside the target, and only when the work has finished
+replaces the target by it in two renames. An interrupted run leaves the
+previous complete folder untouched (and a ``.tmp`` folder that the next run
+removes); no file ever mixes two runs.
+"""
+
+import contextlib
+import errno
+import os
+import shutil
+from pathlib import Path
+
+from .exceptions import InputError
+
+__all__ = ["MARKER", "check_output_dir", "atomic_output_dir"]
+
+#: File that marks a folder as written by hinfnav (so it may be replaced).
+MARKER = ".hinfnav-output"
+
+
+def check_output_dir(path, name="out"):
+    """Validate an output folder before any work; return it as an absolute :class:`Path`."""
+    if path is None or str(path).strip() == "":
+        raise InputError(f"{name} must name a folder; got an empty path")
+    target = Path(path).expanduser().absolute()
+    if target.exists() and not target.is_dir():
+        raise InputError(f"{name} {target} is a file, not a folder")
+    parent = target.parent
+    for anc in [target] + list(target.parents):
+        if anc.exists():
+            if not anc.is_dir():
+                raise InputError(f"{name} {target} lies under {anc}, which is a file")
+            break
+    probe = parent
+    while not probe.exists():
+        probe = probe.parent
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise InputError(f"{name} {target}: cannot write in {probe} (permission denied)")
+    if target.is_dir() and any(target.iterdir()) and not (target / MARKER).exists():
+        raise InputError(
+            f"{name} {target} already holds files that hinfnav did not write; refusing to replace it "
+            "(choose an empty or new folder)"
+        )
+    return target
+
+
+def _lock(target):
+    lock = target.parent / f".{target.name}.lock"
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+        except FileExistsError:
+            try:
+                pid = int(lock.read_text().strip() or 0)
+            except (OSError, ValueError):
+                pid = 0
+            alive = pid > 0
+            if alive:
+                try:
+                    os.kill(pid, 0)
+                except OSError as exc:
+                    alive = exc.errno == errno.EPERM
+            if alive:
+                raise InputError(
+                    f"another process (pid {pid}) is writing into {target}; wait for it or choose another folder"
+                ) from None
+            lock.unlink(missing_ok=True)  # stale lock of a process that died
+            continue
+        with os.fdopen(fd, "w") as fh:
+            fh.write(str(os.getpid()))
+        return lock
+    raise InputError(f"could not lock {target} (lock file {lock})")
+
+
+@contextlib.contextmanager
+def atomic_output_dir(path, *, keep=(), name="out"):
+    """Context manager: yield a temporary folder that replaces ``path`` when the block succeeds.
+
+    Parameters
+    ----------
+    path : str or Path
+        The target folder.
+    keep : sequence of str
+        Entries of the existing target to carry over into the new one (e.g.
+        the sub-folders of other papers when only one paper is redone).
+    name : str
+        Parameter name used in error messages.
+    """
+    target = check_output_dir(path, name)
+    lock = _lock(target)
+    tmp = target.parent / f".{target.name}.tmp"
+    try:
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        (tmp / MARKER).write_text("written by hinfnav; this folder is replaced whole by the next run\n")
+        yield tmp
+        for entry in keep:
+            src = target / entry
+            if src.exists() and not (tmp / entry).exists():
+                shutil.copytree(src, tmp / entry) if src.is_dir() else shutil.copy2(src, tmp / entry)
+        old = target.parent / f".{target.name}.old"
+        shutil.rmtree(old, ignore_errors=True)
+        if target.exists():
+            target.rename(old)
+        tmp.rename(target)
+        shutil.rmtree(old, ignore_errors=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+        lock.unlink(missing_ok=True)
