@@ -52,6 +52,7 @@ _EXPORTS = {
     "convergence_time": "metrics",
     "max_error": "metrics",
     "monte_carlo_summary": "metrics",
+    "monte_carlo_statistics": "metrics",
     "rms_error": "metrics",
     "rms_per_run": "metrics",
     "NOISE_NAMES": "noise",
@@ -165,6 +166,7 @@ __all__ = [
     "max_error",
     "convergence_time",
     "monte_carlo_summary",
+    "monte_carlo_statistics",
     # Sun et al. (2011)
     "Scenario",
     "published_filter",
