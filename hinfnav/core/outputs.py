@@ -12,13 +12,16 @@ removes); no file ever mixes two runs.
 
 import contextlib
 import errno
+import json
 import os
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 from .exceptions import InputError
 
-__all__ = ["MARKER", "check_output_dir", "atomic_output_dir"]
+__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "to_json", "write_json"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
 MARKER = ".hinfnav-output"
@@ -114,3 +117,23 @@ def atomic_output_dir(path, *, keep=(), name="out"):
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
         lock.unlink(missing_ok=True)
+
+
+def to_json(obj):
+    """A JSON-ready copy of ``obj``: numpy arrays and scalars become lists and Python numbers."""
+    if isinstance(obj, dict):
+        return {str(k): to_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_json(obj.tolist())
+    if isinstance(obj, (np.floating, np.integer, np.bool_)):
+        return obj.item()
+    return obj
+
+
+def write_json(path, obj):
+    """Write ``to_json(obj)`` to ``path`` (indented, newline at the end); return the written object."""
+    data = to_json(obj)
+    Path(path).write_text(json.dumps(data, indent=2) + "\n")
+    return data

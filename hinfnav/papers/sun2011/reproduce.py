@@ -1,17 +1,17 @@
 """``python -m hinfnav reproduce --paper sun2011``: Table 1 and Figs 2–7 of Sun et al. (2011) into a folder."""
 
-import json
 import time
 from pathlib import Path
 
-import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
+from ...core.outputs import to_json, write_json
 from ...core.progress import bar_disabled
 from ...core.provenance import provenance
 from ...metrics.errors import rms_per_run
+from ...plotting.save import save_figure
 from .constants import CITATION
 from .designs import design_for_scenario
 from .figures import fig2, fig3, fig4, fig5, fig6, fig7, fig7_result, paper_runs
@@ -20,19 +20,6 @@ from .table1 import CASES, _kl_axes, format_table1, table1, write_table1
 
 __all__ = ["reproduce", "execute_notebooks", "to_json"]
 
-
-
-def _save(fig, out_dir, name, prov):
-    """PNG and PDF of a figure, with the provenance in their metadata."""
-    text = json.dumps(prov)
-    title = fig.texts[0].get_text() if fig.texts else name
-    paths = []
-    for ext, meta in (("png", {"Title": title, "Description": text, "Software": f"hinfnav {prov.get('hinfnav')}"}),
-                      ("pdf", {"Title": title, "Subject": text, "Creator": f"hinfnav {prov.get('hinfnav')}"})):
-        p = Path(out_dir) / f"{name}.{ext}"
-        fig.savefig(p, dpi=130, metadata=meta)
-        paths.append(p)
-    return paths
 
 
 def _summary(tab, designed, observer, fig7_res, scenario):
@@ -67,18 +54,6 @@ def _summary(tab, designed, observer, fig7_res, scenario):
         "observer_filter": {"delta_bar": 0.05, "gamma": float(observer.gamma), "lmi_gamma": float(observer.lmi_gamma),
                             "note": "extension: LMI (20) with C_F = -L and A_F = A + B_F C (observer form)"},
     }
-
-
-def to_json(obj):
-    if isinstance(obj, dict):
-        return {str(k): to_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_json(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_json(obj.tolist())
-    if isinstance(obj, (np.floating, np.integer)):
-        return obj.item()
-    return obj
 
 
 def execute_notebooks(out_dir, timeout=900):
@@ -131,10 +106,8 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
     figs = {"fig2": fig2(runs_), "fig3": fig3(runs_), "fig4": fig4(runs_), "fig5": fig5(runs_), "fig6": fig6(runs_),
             "fig7": fig7(f7)}
     for name, fig in tqdm(figs.items(), disable=bar_disabled(progress), desc="figures", unit="fig"):
-        _save(fig, out, name, prov)
-    summary = to_json(_summary(tab, designed, observer, f7, scenario))
-    summary["provenance"] = to_json(prov)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        save_figure(fig, out, name, prov)
+    summary = write_json(out / "summary.json", dict(_summary(tab, designed, observer, f7, scenario), provenance=prov))
     if notebooks:
         execute_notebooks(out)
     if progress:

@@ -1,0 +1,27 @@
+"""Saving figures with their provenance in the file's metadata."""
+
+import json
+from pathlib import Path
+
+__all__ = ["save_figure"]
+
+
+def save_figure(fig, out_dir, name, provenance=None, *, formats=("png", "pdf"), dpi=130):
+    """Save ``fig`` as ``out_dir/name.<ext>`` for each format; return the paths.
+
+    The provenance dict (see :func:`hinfnav.core.provenance.provenance`) goes into
+    the PNG ``Description`` and the PDF ``Subject``, the figure's title into ``Title``.
+    """
+    prov = provenance or {}
+    text = json.dumps(prov)
+    sup = getattr(fig, "_suptitle", None)
+    title = sup.get_text() if sup is not None else name
+    creator = f"hinfnav {prov.get('hinfnav', '')}".strip()
+    meta = {"png": {"Title": title, "Description": text, "Software": creator},
+            "pdf": {"Title": title, "Subject": text, "Creator": creator}}
+    paths = []
+    for ext in formats:
+        path = Path(out_dir) / f"{name}.{ext}"
+        fig.savefig(path, dpi=dpi, metadata=meta.get(ext))
+        paths.append(path)
+    return paths
