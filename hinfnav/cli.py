@@ -1,4 +1,4 @@
-"""Command line: ``python -m hinfnav {simulate,design,reproduce} ...``.
+"""Command line: ``python -m hinfnav {simulate,design,reproduce,campaign} ...``.
 
 Run ``python -m hinfnav COMMAND --help`` for each command's options. The
 parser imports nothing heavy: each command imports the layers it needs when it
@@ -12,25 +12,25 @@ import math
 import os
 import sys
 
-from .core.exceptions import HinfnavError
+from .core.exceptions import HinfnavError, InputError
+from .core.outputs import check_output_dir
+from .core.validation import check_new_file
 
 __all__ = ["main", "simulate_report", "format_simulate_report", "FILTER_CHOICES", "NOISE_CHOICES", "SOLVER_CHOICES",
-           "PAPER_CHOICES"]
+           "PAPER_CHOICES", "MAX_RUNS"]
 
-#: ``simulate --filter`` choices (= hinfnav.papers.sun2011.FILTER_NAMES).
+#: ``simulate --filter`` choices: every registered estimator that fits Sun 2011's scenario (tested).
 FILTER_CHOICES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
-                  "designed_observer_closed_loop", "ekf", "ekf_known_input")
+                  "designed_observer_closed_loop", "ekf", "ekf_known_input", "recursive_hinf", "hbf",
+                  "ekf_augmented_thrust", "ekf_augmented_thrust_st", "ekf_augmented_thrust_adaptive")
 #: ``--noise`` choices (= hinfnav.noise.NOISE_NAMES).
 NOISE_CHOICES = ("gaussian", "colored", "mixture", "uniform", "laplace", "student_t")
 #: ``design --solver`` choices (= hinfnav.lmi.SOLVERS).
 SOLVER_CHOICES = ("CLARABEL", "CVXOPT", "SCS")
-#: ``reproduce --paper`` choices (= "all" and the keys of hinfnav.papers.PAPERS).
-PAPER_CHOICES = ("all", "sun2011")
-
-_SCS_WARNING = (
-    "warning: SCS is a first-order solver; on this LMI it is slow and loose (measured at delta_bar = 0.05: about "
-    "80 s and a certified gamma of 6.55 against 0.3586 with CLARABEL/CVXOPT). The result is still certified."
-)
+#: Largest ``--runs`` (= hinfnav.papers.sun2011.report.MAX_RUNS), checked before anything heavy is imported.
+MAX_RUNS = 1_000_000
+#: ``reproduce --paper`` choices (= the selections and keys of hinfnav.papers: tested).
+PAPER_CHOICES = ("papers", "all", "sun2011", "shi2018", "attitude2018", "yang2020", "benchmark")
 
 
 def simulate_report(*args, **kwargs):
@@ -48,6 +48,10 @@ def format_simulate_report(rep):
 
 
 def _cmd_simulate(args):
+    import hinfnav.papers  # noqa: F401 - registers every paper's estimators (hbf, recursive_hinf, ...)
+
+    if args.design is not None and not args.design.strip():
+        raise InputError("--design must name a design file (from 'design --save FILE'); got an empty path")
     rep = simulate_report(args.filter, maneuver=not args.no_maneuver, delta=args.delta, noise=args.noise,
                           seed=args.seed, runs=args.runs, discretization=args.discretization,
                           progress=not args.json and args.runs > 1, design=args.design, verbatim=args.verbatim)
@@ -55,10 +59,14 @@ def _cmd_simulate(args):
 
 
 def _cmd_design(args):
+    if args.save is not None:  # before the heavy imports and the solver: an empty path, a folder, a missing folder
+        check_new_file("--save", args.save, example="design.json")
     from .papers.sun2011.designs import design_for_scenario, design_report_from, format_design_report, save_design
 
-    if args.solver == "SCS":
-        print(_SCS_WARNING, file=sys.stderr)
+    if getattr(args, "objective", "hinf") == "h2":
+        return _cmd_design_h2(args, save_design)
+    if getattr(args, "gamma", None) is not None:
+        raise InputError("--gamma applies to --objective h2 (Corollary 1 minimizes gamma itself)")
     result = design_for_scenario(None, args.delta_bar, solver=args.solver, form=args.form)
     rep = design_report_from(result)
     if args.save:
@@ -66,10 +74,41 @@ def _cmd_design(args):
     print(json.dumps(rep, indent=2) if args.json else format_design_report(rep))
 
 
+def _cmd_design_h2(args, save_design):
+    """``design --objective h2``: a mixed H2/H∞ design at ``--gamma``, or the front and its knee (issue 12)."""
+    from .papers.sun2011.mixed_designs import format_mixed_design_report, mixed_design_report
+
+    if args.form != "general":
+        raise InputError("--objective h2 designs general-form filters only; leave out --form observer")
+    if args.points < 2:
+        raise InputError(f"--points must be >= 2; got {args.points}")
+    rep, result = mixed_design_report(args.delta_bar, gamma=args.gamma, solver=args.solver, points=args.points)
+    if args.save:
+        rep["saved_to"] = str(save_design(result, args.save))
+    print(json.dumps(rep, indent=2) if args.json else format_mixed_design_report(rep))
+
+
 def _cmd_reproduce(args):
+    check_output_dir(args.out, "--out")  # before the heavy imports (reproduce checks it again, atomically)
     from .papers import reproduce
 
     reproduce(args.paper, args.out, seed=args.seed, runs=args.runs, notebooks=args.notebooks, progress=True)
+
+
+def _cmd_campaign(args):
+    """``campaign SPEC --out DIR``: run a campaign (issue 13) on a LocalCluster or the cluster at --scheduler."""
+    from .campaign import run_campaign
+    from .papers.benchmark import load_papers
+
+    load_papers()  # every paper's scenarios and estimators, so that SPEC may name any of them
+    table = run_campaign(args.spec, client=args.scheduler, out_dir=args.out, progress=True, workers=args.workers)
+    info = table.attrs
+    print(f"{len(info['cells'])} cells ({info['computed']} computed, {info['reused']} reused); "
+          f"table: {info['out_dir']}/results.csv")
+    for cell_id, message in info["errors"].items():
+        print(f"error: cell {cell_id}: {message}", file=sys.stderr)
+    if info["errors"]:
+        raise HinfnavError(f"{len(info['errors'])} cells failed (see above); run the command again to retry them")
 
 
 def _parser():
@@ -106,17 +145,36 @@ def _parser():
                         "(extension: error independent of the trajectory)")
     d.add_argument("--save", metavar="FILE", default=None,
                    help="write the certified filter, the system it was designed for and provenance to FILE (JSON)")
+    d.add_argument("--objective", default="hinf", choices=("hinf", "h2"),
+                   help="hinf: Corollary 1, min gamma (default); h2: mixed H2/H-infinity, min the certified H2 bound "
+                        "subject to --gamma (without --gamma: the front gamma* .. 10 gamma* and its knee)")
+    d.add_argument("--gamma", type=float, default=None,
+                   help="with --objective h2: the H-infinity bound (above gamma* of Corollary 1)")
+    d.add_argument("--points", type=int, default=12, help="with --objective h2 and no --gamma: front points (default 12)")
     d.add_argument("--json", action="store_true", help="print one JSON object")
     d.set_defaults(func=_cmd_design)
 
     r = sub.add_parser("reproduce", help="regenerate a paper's tables and figures into a folder (Table 1, Figs 2-7)")
-    r.add_argument("--paper", default="all", choices=PAPER_CHOICES,
-                   help="which paper (default: all; sun2011 writes into --out itself)")
+    r.add_argument("--paper", default="papers", choices=PAPER_CHOICES,
+                   help="which paper (default: papers = the four papers; all adds the cross-paper benchmark; "
+                        "sun2011 writes into --out itself, the others into --out/<paper>/)")
     r.add_argument("--out", default="results", help="output folder (default: results/)")
     r.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    r.add_argument("--runs", type=int, default=100, help="Monte Carlo runs per case (default 100)")
+    r.add_argument("--runs", type=int, default=None,
+                   help="Monte Carlo runs per case (default: each paper's own, e.g. 100 for sun2011)")
     r.add_argument("--notebooks", action="store_true", help="also execute the notebooks into the folder")
     r.set_defaults(func=_cmd_reproduce)
+
+    c = sub.add_parser("campaign", help="run a campaign (a grid of estimators x scenarios x noises x runs, TOML) on Dask")
+    c.add_argument("spec", metavar="SPEC", help="campaign file (TOML; see hinfnav.campaign.spec)")
+    c.add_argument("--out", required=True, metavar="DIR",
+                   help="campaign folder: finished cells are written there and reused on the next run (resume)")
+    c.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of a running Dask scheduler (tcp://host:8786); default: a LocalCluster on this "
+                        "machine; 'serial': in this process")
+    c.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="worker processes of the LocalCluster (default: one per core)")
+    c.set_defaults(func=_cmd_campaign)
     return p
 
 
@@ -124,14 +182,18 @@ def main(argv=None):
     """Entry point; returns the exit status (0 ok, 2 bad input, 1 other failure)."""
     parser = _parser()
     args = parser.parse_args(argv)
-    if hasattr(args, "runs") and args.runs < 1:
+    if getattr(args, "runs", None) is not None and args.runs < 1:
         parser.error(f"--runs must be >= 1; got {args.runs}")
+    if getattr(args, "runs", None) is not None and args.runs > MAX_RUNS:
+        parser.error(f"--runs must be at most {MAX_RUNS}; got {args.runs}")
     if hasattr(args, "delta_bar") and not (math.isfinite(args.delta_bar) and args.delta_bar >= 0):
         parser.error(f"--delta-bar must be a finite number >= 0; got {args.delta_bar}")
     if hasattr(args, "delta") and not math.isfinite(args.delta):
         parser.error(f"--delta must be finite; got {args.delta}")
     if getattr(args, "seed", 0) < 0:
         parser.error(f"--seed must be >= 0; got {args.seed}")
+    if getattr(args, "workers", None) is not None and (args.workers < 1 or args.scheduler is not None):
+        parser.error(f"--workers must be >= 1 and applies to the LocalCluster only (not with --scheduler); got {args.workers}")
     if getattr(args, "verbatim", False) and args.design is None:
         parser.error("--verbatim applies to --design only")
     try:
@@ -142,4 +204,8 @@ def main(argv=None):
     except BrokenPipeError:
         # output piped into e.g. `head`, which closed early: not an error of ours
         sys.stdout = open(os.devnull, "w")
+    except OSError as exc:
+        # a file system refusal the checks could not foresee (permissions, a full disk): say it, no traceback
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     return 0

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.exceptions import InputError
-from .core.validation import as_choice, as_int_at_least, as_positive
+from .core.validation import as_choice, as_int_at_least, as_positive, as_real
 
 __all__ = [
     "NoiseModel",
@@ -77,7 +77,13 @@ class NoiseModel:
         -------
         ndarray of the given shape
         """
-        return self._sample(rng, _check(rng, shape))
+        shape = _check(rng, shape)
+        try:
+            return self._sample(rng, shape)
+        except MemoryError:
+            need = 8.0 * float(np.prod([float(s) for s in shape]))
+            raise InputError(f"shape {shape} asks for {need / 2**30:.3g} GiB of samples, more than this machine can "
+                             "hold; draw fewer (e.g. in batches)") from None
 
     def _sample(self, rng, shape):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -161,7 +167,7 @@ class MixtureNoise(NoiseModel):
     name = "mixture"
 
     def __post_init__(self):
-        if not (0.0 <= float(self.eps) <= 1.0):
+        if not (0.0 <= as_real("eps", self.eps) <= 1.0):
             raise InputError(f"eps must be in [0, 1]; got {self.eps}")
         as_positive("ratio", self.ratio)
 

@@ -38,10 +38,15 @@ def test_cli_choices_are_the_packages_own_lists():
     from hinfnav.papers import PAPERS
     from hinfnav.papers.sun2011 import FILTER_NAMES
 
-    assert FILTER_CHOICES == FILTER_NAMES
+    from hinfnav.estimators import registered_estimators
+
+    assert set(FILTER_NAMES) <= set(FILTER_CHOICES)
+    assert set(FILTER_CHOICES) == set(registered_estimators(hn.Scenario()))
     assert NOISE_CHOICES == NOISE_NAMES
     assert SOLVER_CHOICES == SOLVERS
-    assert PAPER_CHOICES == ("all",) + tuple(PAPERS)
+    from hinfnav.papers import SELECTIONS
+
+    assert PAPER_CHOICES == tuple(SELECTIONS) + tuple(PAPERS)
 
 
 def test_design_save_then_simulate_and_refusal_at_another_T(tmp_path, capsys):

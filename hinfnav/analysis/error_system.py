@@ -139,6 +139,8 @@ def worst_case_norm(system, A_F, B_F, C_F, samples=None, dt=None, tol=NORM_TOL):
     -------
     WorstCase
     """
+    if not all(hasattr(system, a) for a in ("A", "B", "C", "D", "L", "dt", "perturbed_A")):
+        raise InputError(f"system must be a hinfnav UncertainSystem; got {type(system).__name__}")
     if samples is None:
         samples = [None]
     dt = system.dt if dt is None else _dt_value(dt)

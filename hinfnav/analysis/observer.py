@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.validation import as_matrix
 
 __all__ = ["observer_form"]
@@ -34,6 +35,9 @@ def observer_form(A_F, B_F, C_F, A, C):
     B_F = as_matrix("B_F", B_F, (A_F.shape[0], None))
     A = as_matrix("A", A, A_F.shape)
     C = as_matrix("C", C, (B_F.shape[1], A_F.shape[0]))
+    cond = np.linalg.cond(C_F)
+    if not cond < 1e12:
+        raise InputError(f"C_F must be invertible (x̂ = C_F x_f); its condition number is {cond:.3g}")
     A_hat = C_F @ np.linalg.solve(C_F.T, A_F.T).T
     G = C_F @ B_F
     return {

@@ -12,6 +12,8 @@ from .exceptions import (
     HinfnavError,
     InfeasibleLMIError,
     InputError,
+    LooseBoundWarning,
+    SolverAccuracyWarning,
     SynthesisError,
     UnstablePlantError,
 )
@@ -35,6 +37,8 @@ __all__ = [
     "SynthesisError",
     "InfeasibleLMIError",
     "CertificationError",
+    "LooseBoundWarning",
+    "SolverAccuracyWarning",
     "as_matrix",
     "as_vector",
     "as_real",

@@ -12,6 +12,8 @@ __all__ = [
     "SynthesisError",
     "InfeasibleLMIError",
     "CertificationError",
+    "LooseBoundWarning",
+    "SolverAccuracyWarning",
 ]
 
 
@@ -45,3 +47,21 @@ class InfeasibleLMIError(SynthesisError):
 
 class CertificationError(SynthesisError):
     """The filter rebuilt from the solver's solution fails independent verification."""
+
+
+class LooseBoundWarning(UserWarning):
+    """A certified level is far above the worst norm actually sampled.
+
+    The certificate is valid (an upper bound), but more than twice the
+    largest H-infinity norm of the error system at the uncertainty samples,
+    after the synthesis tried harder (other solvers, bisection, another
+    scaling). The message gives both numbers.
+    """
+
+
+class SolverAccuracyWarning(UserWarning):
+    """A solver known to be slow and loose on these LMIs was chosen (SCS).
+
+    The result is still certified; the message says how loose it was
+    measured to be.
+    """

@@ -5,12 +5,15 @@ and what is wrong with it, before any numerical work starts.
 """
 
 import numbers
+import os
+from pathlib import Path
 
 import numpy as np
 
 from .exceptions import InputError
 
-__all__ = ["as_matrix", "as_vector", "as_real", "as_positive", "as_nonnegative", "as_int_at_least", "as_choice"]
+__all__ = ["as_matrix", "as_vector", "as_real", "as_positive", "as_nonnegative", "as_int_at_least", "as_choice", "as_seed",
+           "check_keywords", "as_path", "check_new_file"]
 
 
 def _as_float_array(name, value):
@@ -100,3 +103,46 @@ def as_choice(name, value, choices):
     if value not in choices:
         raise InputError(f"unknown {name} {value!r}; choose one of: {', '.join(map(str, choices))}")
     return value
+
+
+def as_seed(name, value):
+    """Return ``value`` if it can seed :func:`numpy.random.default_rng`: an int >= 0, a SeedSequence or a Generator."""
+    if isinstance(value, (np.random.SeedSequence, np.random.Generator)):
+        return value
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise InputError(f"{name} must be a non-negative integer or a numpy.random.Generator; got {value!r}")
+    if value < 0:
+        raise InputError(f"{name} must be a non-negative integer; got {value}")
+    return value
+
+
+def check_keywords(what, given, allowed):
+    """Raise naming the unknown keywords among ``given`` (a mapping or names) and listing the ``allowed`` ones."""
+    unknown = sorted(set(given) - set(allowed))
+    if unknown:
+        raise InputError(f"unknown {what} {', '.join(map(repr, unknown))}; valid: {', '.join(sorted(allowed)) or 'none'}")
+
+
+def as_path(name, value):
+    """Return ``value`` as a non-empty :class:`pathlib.Path` (a str or path-like)."""
+    if isinstance(value, bytes):
+        value = value.decode(errors="replace")
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{name} must be a file path (str or pathlib.Path); got {type(value).__name__}")
+    if str(value).strip() == "":
+        raise InputError(f"{name} must name a file; got an empty path")
+    return Path(value)
+
+
+def check_new_file(name, value, example="result.json"):
+    """Return ``value`` as a Path where a file can be written: not empty, not a folder, in an existing folder."""
+    path = as_path(name, value)
+    if str(path) == ".":
+        raise InputError(f"{name} must name a file; got an empty path")
+    if path.is_dir():
+        raise InputError(f"{name} {path} is a directory; give a file name such as {example}")
+    if not path.parent.exists():
+        raise InputError(f"{name} {path}: the folder {path.parent} does not exist")
+    if not path.parent.is_dir():
+        raise InputError(f"{name} {path}: {path.parent} is a file, not a folder")
+    return path

@@ -6,12 +6,19 @@ the solver reported.
 
 from ..lmi.solve import SOLVERS, SolverOptions
 from .io import check_design_system, load_design, save_design, system_fingerprint
+from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
 from .result import SynthesisResult
 from .robust_hinf import FORMS, synthesize
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
 __all__ = [
     "synthesize",
+    "synthesize_mixed",
+    "mixed_front",
+    "MixedSynthesisResult",
+    "MixedFront",
+    "front_gammas",
+    "knee_index",
     "SynthesisResult",
     "SolverOptions",
     "SOLVERS",

@@ -11,17 +11,17 @@ for.
 
 import hashlib
 import json
-from pathlib import Path
 
 import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.provenance import provenance
+from ..core.validation import as_path, check_new_file
 from ..systems.uncertain import UncertainSystem
 from .result import SynthesisResult
 
 __all__ = ["FORMAT", "system_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
-           "check_design_system"]
+           "check_design_system", "check_design_path"]
 
 #: Identifier and version of the file format.
 FORMAT = "hinfnav-design/1"
@@ -97,8 +97,19 @@ def design_from_dict(d, path="<dict>"):
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise InputError(f"{path} is not a hinfnav design file (format {FORMAT!r} expected)")
     f, c, s = d.get("filter", {}), d.get("certificate", {}), d.get("system", {})
+    if not all(isinstance(x, dict) for x in (f, c, s)):
+        raise InputError(f"design file {path}: 'filter', 'certificate' and 'system' must be JSON objects")
     A_F, B_F, C_F = (_matrix(f, k, path) for k in ("A_F", "B_F", "C_F"))
     mats = {k: (None if s.get(k) is None else _matrix(s, k, path)) for k in _MATRICES}
+    try:
+        return _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path)
+    except (KeyError, TypeError, ValueError) as exc:
+        if isinstance(exc, InputError):
+            raise
+        raise InputError(f"design file {path}: missing or malformed entry ({type(exc).__name__}: {exc})") from None
+
+
+def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
     system = UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], mats["H"], mats["E"], float(s["dt"]))
     result = SynthesisResult(
         A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),
@@ -114,15 +125,14 @@ def design_from_dict(d, path="<dict>"):
     return result, system, d
 
 
+def check_design_path(path):
+    """Check, before any work, that a design file can be written at ``path``; returns it as a Path."""
+    return check_new_file("path", path, example="design.json")
+
+
 def save_design(result, system, path, *, options=None, extra=None):
     """Write a design file (JSON); returns the path. The file is written whole or not at all."""
-    path = Path(path)
-    if str(path) in ("", "."):
-        raise InputError("path must name a file for the design; got an empty path")
-    if path.is_dir():
-        raise InputError(f"path {path} is a directory; give a file name such as design.json")
-    if not path.parent.exists():
-        raise InputError(f"path {path}: the folder {path.parent} does not exist")
+    path = check_design_path(path)
     text = json.dumps(design_to_dict(result, system, options=options, extra=extra), indent=2) + "\n"
     tmp = path.with_name(f".{path.name}.tmp")
     tmp.write_text(text)
@@ -132,7 +142,7 @@ def save_design(result, system, path, *, options=None, extra=None):
 
 def load_design(path):
     """Read a design file; returns ``(SynthesisResult, UncertainSystem, dict)``."""
-    path = Path(path)
+    path = as_path("path", path)
     if not path.is_file():
         raise InputError(f"design file {path} does not exist (or is not a file)")
     try:

@@ -6,6 +6,11 @@ matrices.
 
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
 from .huber import HuberUpdate, huber_update
+from .adaptive import RateAdaptive, StrongTracking
+from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputKF, AugmentedInputSTKF
+from .extended_state import ExtendedStateKalmanFilter, FusedExtendedStateFilter, SaturatedExtendedStateFilter
+from .huber_filter import HuberFilter
+from .recursive_hinf import RecursiveHInfinityFilter
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 from .lti import LTIFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -21,6 +26,17 @@ __all__ = [
     "OUTPUTS",
     "huber_update",
     "HuberUpdate",
+    "HuberFilter",
+    "ExtendedStateKalmanFilter",
+    "SaturatedExtendedStateFilter",
+    "FusedExtendedStateFilter",
+    "RecursiveHInfinityFilter",
+    "StrongTracking",
+    "RateAdaptive",
+    "AugmentedEKF",
+    "AugmentedInputKF",
+    "AugmentedInputSTKF",
+    "AugmentedInputAdaptiveKF",
     "register_estimator",
     "build_estimator",
     "registered_estimators",

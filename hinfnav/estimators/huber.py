@@ -21,11 +21,20 @@ the Kalman (OLS) solution. The reported covariance is
 ``P = (M^T Psi M)^{-1}`` at the final weights.
 
 Plain IRLS converges only linearly (hundreds of steps when several whitened
-residuals are large), so each iteration also tries Newton steps of the
-piecewise-quadratic cost, backtracked, and keeps the cheapest candidate,
-IRLS step included: the cost falls at least as much as under IRLS and the
-limit is the same Huber minimiser. Once the rows beyond ``gamma`` are
-identified, the Newton point is the exact minimiser and the iteration ends.
+residuals are large), so each iteration first tries the Newton point of the
+piecewise-quadratic cost for the current split of the rows into those within
+and beyond ``gamma``; if it reproduces that split it is the exact minimiser
+and the iteration ends. Otherwise the iteration keeps the cheapest of the
+IRLS step and backtracked (damped) Newton steps: the cost falls at least as
+much as under IRLS and the limit is the same Huber minimiser.
+
+Speed. A run whose least-squares (Kalman) residuals all lie within
+``gamma`` is finished after the least-squares solve. The weighted
+least-squares problems are solved by their normal equations, scaled to a
+unit diagonal (Jacobi) before an LU solve: for these small, well-posed
+systems (the whitened prior rows make ``M`` of full column rank) this loses
+nothing measurable against QR (the tests compare with the Kalman formula to
+1e-12 and with cvxpy to 1e-8) and is about ten times faster batched.
 """
 
 from dataclasses import dataclass
@@ -99,20 +108,129 @@ def _cholesky(name, C):
         raise InputError(f"{name} must be positive definite; its Cholesky factorisation fails") from None
 
 
-def _weighted_ls(M, y, w):
-    """Solve ``min sum_i w_i (M_i x - y_i)^2`` for a batch, by QR of sqrt(w) M.
+def _chol(A, pivot_tol=1e-12):
+    """Cholesky factors of a batch of symmetric matrices; ``(L, ok)``.
 
-    Returns the solution and the upper-triangular factor ``U`` with
-    ``U^T U = M^T diag(w) M``.
+    LAPACK factors the whole batch at once; if one matrix is not positive
+    definite (LAPACK then fails for the batch) the factors are computed by
+    columns vectorised over the batch, and ``ok`` is False for a run whose
+    pivot falls to ``pivot_tol`` times its largest diagonal entry or below
+    (singular or indefinite to working precision; its factor is meaningless).
     """
-    sw = np.sqrt(w)
-    Q, U = np.linalg.qr(sw[..., :, None] * M, mode="reduced")
-    rhs = np.einsum("...ji,...j->...i", Q, sw * y)
-    x = np.linalg.solve(U, rhs[..., None])[..., 0]
-    return x, U
+    try:
+        return np.linalg.cholesky(A), np.ones(A.shape[0], dtype=bool)
+    except np.linalg.LinAlgError:
+        pass
+    n = A.shape[-1]
+    L = np.zeros_like(A)
+    floor = pivot_tol * np.max(np.abs(np.diagonal(A, axis1=-2, axis2=-1)), axis=-1)
+    ok = np.isfinite(floor)
+    for j in range(n):
+        lj = L[:, j, :j]
+        d = A[:, j, j] - np.sum(lj * lj, axis=-1)
+        good = d > floor
+        ok &= good
+        piv = np.sqrt(np.where(good, d, 1.0))
+        L[:, j, j] = piv
+        if j + 1 < n:
+            L[:, j + 1:, j] = (A[:, j + 1:, j] - (L[:, j + 1:, :j] @ lj[:, :, None])[..., 0]) / piv[:, None]
+    return L, ok
 
 
-def _newton_steps(M, y, x, zeta, gamma):
+#: Below this many runs one LAPACK call per matrix is cheaper than the column loops.
+_SMALL_BATCH = 48
+
+
+def _tri_solve(L, b, lower=True):
+    """``L^{-1} b`` (or ``L^{-T} b`` with ``lower=False``) for a batch of lower-triangular ``L``."""
+    if L.shape[0] < _SMALL_BATCH:
+        return np.linalg.solve(L if lower else np.swapaxes(L, -1, -2), b[..., None])[..., 0]
+    n = L.shape[-1]
+    x = np.zeros(np.broadcast_shapes(L.shape[:-1], b.shape))
+    for i in range(n) if lower else reversed(range(n)):
+        if lower:
+            acc = np.sum(L[:, i, :i] * x[:, :i], axis=-1)
+        else:
+            acc = np.sum(L[:, i + 1:, i] * x[:, i + 1:], axis=-1)
+        x[:, i] = (b[:, i] - acc) / L[:, i, i]
+    return x
+
+
+def _tri_inv(L):
+    """``L^{-1}`` for a batch of lower-triangular ``L`` (forward substitution on the identity)."""
+    if L.shape[0] < _SMALL_BATCH:
+        return np.linalg.inv(L)
+    n = L.shape[-1]
+    X = np.zeros_like(L)
+    for i in range(n):
+        X[:, i, :i + 1] = -(L[:, i:i + 1, :i] @ X[:, :i, :i + 1])[:, 0] / L[:, i, i, None]
+        X[:, i, i] = 1.0 / L[:, i, i]
+    return X
+
+
+def _scaled(A):
+    """Jacobi scaling ``(s, S A S)``, ``s = diag(A)^{-1/2}`` (1 where the diagonal is not positive)."""
+    d = np.diagonal(A, axis1=-2, axis2=-1)
+    good = np.isfinite(d) & (d > 0)
+    s = np.where(good, 1.0 / np.sqrt(np.where(good, d, 1.0)), 1.0)
+    return s, A * s[:, :, None] * s[:, None, :], np.all(good, axis=-1)
+
+
+def _spd_solve(A, b, usable=None):
+    """Solve ``A x = b`` for a batch of symmetric positive (semi)definite ``A``; ``(x, ok)``.
+
+    The matrices are scaled to a unit diagonal (Jacobi) and factored by
+    :func:`_chol`. ``ok`` is False where the system is singular to working
+    precision, where ``usable`` (a boolean per run, optional) is False, or
+    where the solution is not finite (``x`` is then 0 there): the caller
+    treats such runs as having no step.
+    """
+    s, As, ok = _scaled(A)
+    if usable is not None:
+        ok = ok & usable
+    As = np.where(ok[:, None, None], As, np.eye(A.shape[-1]))
+    L, good = _chol(As)
+    ok = ok & good
+    with np.errstate(all="ignore"):
+        x = s * _tri_solve(L, _tri_solve(L, s * b), lower=False)
+    ok = ok & np.all(np.isfinite(x), axis=-1)
+    return np.where(ok[:, None], x, 0.0), ok
+
+
+def _mv(M, x):
+    """``M x`` for a batch (``M`` (r, k, n), ``x`` (r, n))."""
+    return (M @ x[..., None])[..., 0]
+
+
+def _mtv(M, v):
+    """``M^T v`` for a batch (``M`` (r, k, n), ``v`` (r, k))."""
+    return (v[..., None, :] @ M)[..., 0, :]
+
+
+def _normal_matrix(M, w):
+    """``M^T diag(w) M`` for a batch."""
+    return np.swapaxes(M * w[..., :, None], -1, -2) @ M
+
+
+def _weighted_ls(M, y, w):
+    """Solve ``min sum_i w_i (M_i x - y_i)^2`` for a batch (weights > 0, M of full column rank).
+
+    Returns the solution and the normal matrix ``M^T diag(w) M``.
+    """
+    A = _normal_matrix(M, w)
+    x, _ = _spd_solve(A, _mtv(M, w * y))
+    return x, A
+
+
+def _covariance(A):
+    """``A^{-1}`` of a batch of symmetric positive definite matrices (by the scaled Cholesky factor), symmetric."""
+    s, As, _ = _scaled(A)
+    Li = _tri_inv(_chol(As)[0])
+    P = (np.swapaxes(Li, -1, -2) @ Li) * s[:, :, None] * s[:, None, :]
+    return 0.5 * (P + np.swapaxes(P, -1, -2))
+
+
+def _newton_steps(M, y, x, zeta, gamma, betas=None):
     """Newton-type candidates for the Huber cost at ``x``, and whether the first is exact.
 
     The cost is piecewise quadratic: with ``Q`` the rows where
@@ -122,24 +240,22 @@ def _newton_steps(M, y, x, zeta, gamma):
     classification it is the minimiser (global, by convexity). When
     ``M_Q`` has too few rows the Hessian is singular, so further candidates
     give the linear rows a small curvature ``beta * psi`` (``beta`` in
-    ``_BETAS``); ``beta = 1`` would be the IRLS step.
+    ``_BETAS``, or ``betas`` when given, which must start with 0); ``beta = 1``
+    would be the IRLS step.
     """
     n = M.shape[-1]
     quad = np.abs(zeta) <= gamma
     sign = np.sign(zeta)
-    grad = np.einsum("rji,rj->ri", M, np.where(quad, zeta, gamma * sign))
+    grad = _mtv(M, np.where(quad, zeta, gamma * sign))
     psi = _huber_weights(zeta, gamma)
     cands, exact = [], None
-    for beta in _BETAS:
+    for beta in _BETAS if betas is None else betas:
         d = np.where(quad, 1.0, beta * psi)
-        _, U = np.linalg.qr(np.sqrt(d)[..., :, None] * M, mode="reduced")
-        diag = np.abs(np.diagonal(U, axis1=-2, axis2=-1))
-        ok = diag.min(axis=-1) > 1e-10 * np.maximum(diag.max(axis=-1), np.finfo(float).tiny)
-        U = np.where(ok[:, None, None], U, np.eye(n))  # singular runs: dummy step, rejected by cost or flag
-        dx = np.linalg.solve(U, np.linalg.solve(np.swapaxes(U, -1, -2), grad[..., None]))[..., 0]
+        # singular runs (too few rows within gamma): no step, rejected by cost or flag
+        dx, ok = _spd_solve(_normal_matrix(M, d), grad, usable=(quad.sum(axis=-1) >= n) if beta == 0.0 else None)
         cands.append(x - dx)
         if beta == 0.0:
-            zc = np.einsum("rij,rj->ri", M, x - dx) - y
+            zc = _mv(M, x - dx) - y
             slack = 1e-12 * gamma
             same = np.where(quad, np.abs(zc) <= gamma + slack, sign * zc >= gamma - slack).all(axis=-1)
             exact = ok & same
@@ -158,6 +274,47 @@ def _huber_cost(zeta, gamma):
 def _huber_weights(zeta, gamma):
     a = np.abs(zeta)
     return np.where(a <= gamma, 1.0, gamma / np.maximum(a, gamma))
+
+
+def _minimise(M, y, x, gamma, tol, max_iter):
+    """Minimise ``sum rho_gamma(M x - y)`` from ``x`` for a batch; ``(x, iterations, converged)``.
+
+    Each iteration takes the Newton point of the current split of the rows
+    (within / beyond gamma) where it is verified exact, else the cheapest of
+    the IRLS step and backtracked (damped) Newton steps.
+    """
+    runs, n = x.shape
+    x = x.copy()
+    iterations = np.zeros(runs, dtype=int)
+    converged = np.zeros(runs, dtype=bool)
+    for _ in range(max_iter):
+        act = np.flatnonzero(~converged)
+        if act.size == 0:
+            break
+        Ma, ya, xa = M[act], y[act], x[act]
+        zeta = _mv(Ma, xa) - ya
+        # The Newton point of the current classification; where it is verified
+        # exact it is the minimiser and nothing else is needed.
+        x0c, exact = _newton_steps(Ma, ya, xa, zeta, gamma, betas=(0.0,))
+        x_next = x0c[:, 0].copy()
+        step = np.zeros(act.size)
+        rest = np.flatnonzero(~exact)
+        if rest.size:
+            Mr, yr, xr, zr = Ma[rest], ya[rest], xa[rest], zeta[rest]
+            xn, _ = _weighted_ls(Mr, yr, _huber_weights(zr, gamma))  # IRLS step
+            step[rest] = np.max(np.abs(_mv(Mr, xn - xr)), axis=1)
+            # Newton steps of the piecewise-quadratic cost, backtracked; keep the
+            # cheapest of them and the IRLS step, so the cost decreases at least
+            # as much as under plain IRLS.
+            xc, _ = _newton_steps(Mr, yr, xr, zr, gamma)
+            dirs = (xc - xr[:, None])[:, :, None] * _BACKTRACK[None, None, :, None]
+            trial = np.concatenate([xn[:, None], xr[:, None] + dirs.reshape(rest.size, -1, n)], axis=1)
+            cost = _huber_cost((trial @ np.swapaxes(Mr, -1, -2)) - yr[:, None], gamma)
+            x_next[rest] = trial[np.arange(rest.size), np.argmin(cost, axis=1)]
+        x[act] = x_next
+        iterations[act] += 1
+        converged[act] = exact | (step <= tol)
+    return x, iterations, converged
 
 
 def huber_update(x_prior, P_prior, z, H, R, *, gamma=1.345, tol=1e-10, max_iter=50):
@@ -246,40 +403,36 @@ def huber_update(x_prior, P_prior, z, H, R, *, gamma=1.345, tol=1e-10, max_iter=
 
     L_R = full(_cholesky("R", R), 2)
     L_P = full(_cholesky("P_prior", P_prior), 2)
-    x0, zz, HH = full(x_prior, 1), full(z, 1), full(H, 2)
+    x0, zz, HH, PP, RR = full(x_prior, 1), full(z, 1), full(H, 2), full(P_prior, 2), full(R, 2)
 
-    # Whitened regression: M = S^{-1} [H; I], y = S^{-1} [z; x_prior].
-    M = np.concatenate([np.linalg.solve(L_R, HH), np.linalg.solve(L_P, np.broadcast_to(np.eye(n), (nr, n, n)))], axis=1)
-    y = np.concatenate([np.linalg.solve(L_R, zz[..., None])[..., 0], np.linalg.solve(L_P, x0[..., None])[..., 0]], axis=1)
-
-    x, _ = _weighted_ls(M, y, np.ones((nr, m + n)))  # ordinary least squares = Kalman update
-    iterations = np.zeros(nr, dtype=int)
-    converged = np.zeros(nr, dtype=bool)
-    for _ in range(max_iter):
-        act = np.flatnonzero(~converged)
-        if act.size == 0:
-            break
-        Ma, ya, xa = M[act], y[act], x[act]
-        zeta = np.einsum("rij,rj->ri", Ma, xa) - ya
-        xn, _ = _weighted_ls(Ma, ya, _huber_weights(zeta, gamma))  # IRLS step
-        step = np.max(np.abs(np.einsum("rij,rj->ri", Ma, xn - xa)), axis=1)
-        # Newton step of the piecewise-quadratic cost, backtracked; keep the
-        # cheapest of it and the IRLS step, so the cost decreases at least as
-        # much as under plain IRLS.
-        xc, exact = _newton_steps(Ma, ya, xa, zeta, gamma)
-        dirs = (xc - xa[:, None])[:, :, None] * _BACKTRACK[None, None, :, None]
-        trial = np.concatenate([xn[:, None], xa[:, None] + dirs.reshape(act.size, -1, n)], axis=1)
-        cost = _huber_cost(np.einsum("rij,rtj->rti", Ma, trial) - ya[:, None], gamma)
-        best = trial[np.arange(act.size), np.argmin(cost, axis=1)]
-        x[act] = np.where(exact[:, None], xc[:, 0], best)
-        iterations[act] += 1
-        converged[act] = exact | (step <= tol)
-
-    w = _huber_weights(np.einsum("rij,rj->ri", M, x) - y, gamma)
-    _, U = _weighted_ls(M, y, w)
-    Uinv = np.linalg.solve(U, np.broadcast_to(np.eye(n), (nr, n, n)))
-    P = Uinv @ np.swapaxes(Uinv, -1, -2)
+    # Least squares on the whole regression is the Kalman update; it is computed
+    # in its usual form (an m x m solve), with the Joseph-form covariance.
+    PHt = PP @ np.swapaxes(HH, -1, -2)
+    K = np.swapaxes(np.linalg.solve(HH @ PHt + RR, np.swapaxes(PHt, -1, -2)), -1, -2)
+    x = x0 + _mv(K, zz - _mv(HH, x0))
+    # Its whitened residuals, M x - y = [L_R^{-1}(H x - z); L_P^{-1}(x - x_prior)]. A run
+    # whose residuals all lie within gamma is already the minimiser (there the Huber
+    # cost is the least-squares cost): its first iteration would only verify that.
+    zeta = np.concatenate([_tri_solve(L_R, _mv(HH, x) - zz), _tri_solve(L_P, x - x0)], axis=1)
+    inside = np.all(np.abs(zeta) <= gamma, axis=-1)
+    iterations = np.ones(nr, dtype=int)
+    converged = inside.copy()
+    w = np.ones((nr, m + n))
+    I_KH = np.eye(n) - K @ HH
+    P = I_KH @ PP @ np.swapaxes(I_KH, -1, -2) + K @ RR @ np.swapaxes(K, -1, -2)
     P = 0.5 * (P + np.swapaxes(P, -1, -2))
+
+    out = np.flatnonzero(~inside)
+    if out.size:
+        # Whitened regression of those runs: M = S^{-1} [H; I], y = S^{-1} [z; x_prior].
+        LRi = _tri_inv(np.ascontiguousarray(L_R[out]))
+        LPi = _tri_inv(np.ascontiguousarray(L_P[out]))
+        M = np.concatenate([LRi @ HH[out], LPi], axis=1)
+        y = np.concatenate([_mv(LRi, zz[out]), _mv(LPi, x0[out])], axis=1)
+        xs, its, conv = _minimise(M, y, x[out], gamma, tol, max_iter)
+        x[out], iterations[out], converged[out] = xs, its, conv
+        w[out] = _huber_weights(_mv(M, xs) - y, gamma)
+        P[out] = _covariance(_normal_matrix(M, w[out]))
 
     if batched:
         return HuberUpdate(x=x, P=P, weights=w, iterations=iterations, converged=converged)

@@ -8,6 +8,9 @@ class with small hooks that the variants override:
   (strong tracking multiplies by fading factors);
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
+* :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
+  unless the measurement's covariance depends on its reading (a converted
+  range/angle measurement: ``J R Jᵀ`` at each reading);
 * the system it is built on (augmented and extended-state filters append
   states to it).
 
@@ -45,7 +48,11 @@ class ExtendedKalmanFilter(Estimator):
     Q : array_like, shape (n, n), optional
         Process-noise covariance per step (positive semidefinite).
     R : array_like, shape (m, m), optional
-        Measurement-noise covariance (positive definite).
+        Measurement-noise covariance (positive definite). Default: the
+        measurement's ``R``, or, for a measurement whose covariance depends on
+        its reading (one with ``noise_covariance(y)``, e.g.
+        :class:`~hinfnav.systems.measurements.ConvertedPosition`), ``R_k``
+        from each reading (see :meth:`measurement_covariance`).
     uses_input : bool
         Propagate with the applied input, ``Φ x̂ + Γ u`` (True), or ignore u.
     output : {"filtered", "predicted"}
@@ -59,7 +66,13 @@ class ExtendedKalmanFilter(Estimator):
         super().__init__(system, measurement, name=name)
         n, m = system.n, measurement.n_meas
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
-        self.R = as_covariance("R", measurement.R if R is None else R, m, definite=True)
+        #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
+        self.R_of_reading = getattr(measurement, "noise_covariance", None) if R is None else None
+        if self.R_of_reading is None:
+            self.R = as_covariance("R" if R is not None else "R = D Dᵀ of the measurement's noise matrix D (give a D of "
+                                   "full row rank, or R)", measurement.R if R is None else R, m, definite=True)
+        else:
+            self.R = None
         self.P0 = as_covariance("P0", P0, n, definite=True)
         if not isinstance(uses_input, (bool, np.bool_)):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
@@ -71,8 +84,8 @@ class ExtendedKalmanFilter(Estimator):
 
     @property
     def shares_covariance(self):
-        """True when P and the gain do not depend on the data (linear measurement)."""
-        return bool(self.measurement.linear)
+        """True when P and the gain do not depend on the data (linear measurement, constant R)."""
+        return bool(self.measurement.linear) and self.R_of_reading is None
 
     # -- hooks ------------------------------------------------------------------
 
@@ -87,21 +100,32 @@ class ExtendedKalmanFilter(Estimator):
         """``Φ P Φᵀ + Q`` (P shared (n, n) or per run (runs, n, n))."""
         return self.F @ P @ self.F.T + self.Q
 
-    def correct(self, x, P, H, innovation, state):
+    def measurement_covariance(self, y, x):
+        """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
+
+        None means the constant :attr:`R` (and :meth:`correct` is called
+        without an ``R`` argument, as before this hook existed).
+        """
+        return None if self.R_of_reading is None else self.R_of_reading(y)
+
+    def correct(self, x, P, H, innovation, state, R=None):
         """Joseph-form Kalman update; returns ``(x⁺, P⁺, diagnostics)``.
 
-        ``H`` is (m, n) when P is shared, (runs, m, n) otherwise.
+        ``H`` is (m, n) when P is shared, (runs, m, n) otherwise; ``R`` is
+        the step's covariance when it depends on the reading (default the
+        constant :attr:`R`).
         """
+        R = self.R if R is None else R
         HT = np.swapaxes(H, -1, -2)
         PHT = P @ HT
-        S = H @ PHT + self.R
+        S = H @ PHT + R
         K = PHT @ np.linalg.inv(S)
         if K.ndim == 2:
             x_post = x + innovation @ K.T
         else:
             x_post = x + np.einsum("rij,rj->ri", K, innovation)
         I_KH = self._I - K @ H
-        P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ self.R @ np.swapaxes(K, -1, -2)
+        P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
         return x_post, P_post, {}
 
     # -- the step contract --------------------------------------------------------
@@ -121,7 +145,11 @@ class ExtendedKalmanFilter(Estimator):
             innovation = self.measurement.residual(y, self.measurement.function(x))
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
-        x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        R_k = self.measurement_covariance(y, x)
+        if R_k is None:
+            x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        else:
+            x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
         diag = dict(diag, innovation=innovation)
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":

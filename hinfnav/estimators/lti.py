@@ -3,6 +3,7 @@
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
 
@@ -68,6 +69,13 @@ class LTIFilter(Estimator):
             self.K = None
             self._M = None
             self._A_eff = self.A_F
+        rho = spectral_radius(self._A_eff)
+        if not rho < 1.0:
+            what = "A_F with the input correction (A_F − C_F⁻¹ G K C_F)" if self.uses_input else "A_F"
+            raise InputError(
+                f"{what} must be Schur stable (spectral radius < 1); it is {rho:.6g}: the filter's estimates "
+                "would diverge whatever the data (check A_F, or the T and K it was designed for)"
+            )
 
     @property
     def n_input(self):

@@ -38,6 +38,10 @@ def register_estimator(name, builder, *, fits=None, description=""):
     """
     if not isinstance(name, str) or not name:
         raise InputError(f"estimator name must be a non-empty string; got {name!r}")
+    if not callable(builder):
+        raise InputError(f"builder must be callable as builder(scenario, **options); got {type(builder).__name__}")
+    if fits is not None and not callable(fits):
+        raise InputError(f"fits must be callable as fits(scenario) -> bool; got {type(fits).__name__}")
     _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description)
 
 
@@ -48,7 +52,7 @@ def registered_estimators(scenario=None):
 
 def estimator_entry(name):
     """The registry entry of ``name`` (builder, fits, description)."""
-    if name not in _REGISTRY:
+    if not isinstance(name, str) or name not in _REGISTRY:
         raise InputError(f"unknown filter {name!r}; choose one of: {', '.join(_REGISTRY)}")
     return _REGISTRY[name]
 

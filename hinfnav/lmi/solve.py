@@ -5,6 +5,9 @@ solvers, in which order, method, margins, tolerances, bisection, polishing,
 state scaling) in one object, in the manner of dkpy's synthesis strategies.
 """
 
+import dataclasses
+import math
+import numbers
 import time
 import warnings
 from dataclasses import dataclass
@@ -15,6 +18,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
+from .conditioning import NORMALIZE_THRESHOLD
 
 __all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SolverOptions", "Solution", "solve_lmi"]
 
@@ -55,6 +59,13 @@ class SolverOptions:
         and keep the smallest certified γ.
     state_scaling : {"balance", "none"} or tuple of float
         Diagonal state-coordinate scaling (rounded to powers of two).
+    normalize_above : float
+        Scale of the noise block (B, D) or of the output block (L) above
+        which it is normalised by a power of two before solving, and the
+        normalisation undone exactly
+        (:func:`hinfnav.lmi.conditioning.normalize`; default
+        :data:`~hinfnav.lmi.conditioning.NORMALIZE_THRESHOLD`, 0: always,
+        ``inf``: never).
     """
 
     solvers: tuple = ("CLARABEL", "CVXOPT")
@@ -65,6 +76,7 @@ class SolverOptions:
     max_bisection: int = 40
     polish: bool = True
     state_scaling: object = "balance"
+    normalize_above: float = NORMALIZE_THRESHOLD
 
     def __post_init__(self):
         solvers = self.solvers
@@ -87,6 +99,10 @@ class SolverOptions:
             raise InputError(f"polish must be True or False; got {self.polish!r}")
         if not isinstance(self.state_scaling, str):
             object.__setattr__(self, "state_scaling", tuple(float(v) for v in np.ravel(self.state_scaling)))
+        na = self.normalize_above
+        if isinstance(na, bool) or not isinstance(na, numbers.Real) or math.isnan(na) or na < 0:
+            raise InputError(f"normalize_above must be a number >= 0 (inf: never normalise); got {na!r}")
+        object.__setattr__(self, "normalize_above", float(na))
 
     @classmethod
     def only(cls, solver, **changes):
@@ -123,6 +139,13 @@ def solver_kwargs(solver, accuracy):
 def solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
     """One cvxpy solve of LMI (20) on prepared data (internal).
 
+    When ``P`` is normalised (:func:`hinfnav.lmi.conditioning.normalize`),
+    the solver sees the normalised data, and ``gamma2`` and the returned
+    solution are in the units of the original data: ``γ'² = γ²/(νρ)²`` is
+    solved for, and ``R, S, Ā_F, B̄_F, λ`` come back multiplied by ν²,
+    ``C̄_F`` by ν and γ² by (νρ)² (exact, powers of two); the margin is the
+    normalised problem's (its sign is what matters).
+
     ``gamma2=None``: minimize γ² subject to (20) ≤ −margin·I (Corollary 1).
     ``gamma2`` a number: feasibility at that level, maximizing the margin t
     in (20) ≤ −t·I up to a cap (an interior point, which certifies well).
@@ -137,6 +160,27 @@ def solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
     B̄_F, λ), on which the solvers converge (on (20) with the substitution
     they stop with numerical errors near the optimum).
     """
+    if not P.normalized:
+        return _solve_once(P, solver, margin, accuracy, gamma2, bound)
+    g = P.nu * P.rho
+    level = gamma2 if gamma2 is None or isinstance(gamma2, str) else float(gamma2) / g**2
+    sol = _solve_once(P, solver, margin, accuracy, level, bound)
+    if sol.R is None:
+        return dataclasses.replace(sol, gamma2=sol.gamma2 * g**2)
+    k = P.nu**2
+    return dataclasses.replace(
+        sol,
+        gamma2=sol.gamma2 * g**2,
+        R=sol.R * k,
+        S=sol.S * k,
+        Abar_F=sol.Abar_F * k,
+        Bbar_F=sol.Bbar_F * k,
+        Cbar_F=sol.Cbar_F * P.nu,
+        lam=sol.lam * k,
+    )
+
+
+def _solve_once(P, solver, margin, accuracy, gamma2, bound):
     n, p = P.B.shape
     m = P.C.shape[0]
     q = P.D.shape[1]

@@ -27,15 +27,25 @@ __all__ = [
 ]
 
 
+def _float_array(name, value):
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be an array of real numbers; got {type(value).__name__} ({exc})") from None
+
+
 def _check_error(error, t):
-    error = np.asarray(error, dtype=float)
+    error = _float_array("error", error)
     if error.ndim == 2:
         error = error[None]
-    if error.ndim != 3 or error.shape[2] < 1:
-        raise InputError(f"error must have shape (runs, n_samples, n) or (n_samples, n); got {np.shape(error)}")
-    t = np.asarray(t, dtype=float)
+    if error.ndim != 3 or min(error.shape) < 1:
+        raise InputError(f"error must have shape (runs, n_samples, n) or (n_samples, n), none of them 0; "
+                         f"got {np.shape(error)}")
+    t = _float_array("t", t)
     if t.shape != (error.shape[1],):
         raise InputError(f"t must have shape ({error.shape[1]},) to match error; got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise InputError("t must contain only finite times (s); it has NaN or inf entries")
     if not np.all(np.isfinite(error)):
         bad = np.argwhere(~np.isfinite(error))[0]
         raise InputError(
@@ -117,7 +127,10 @@ def convergence_time(error, t, tol):
         components; ``nan`` for a run that never settles.
     """
     error, t = _check_error(error, t)
-    tol = np.broadcast_to(np.asarray(tol, dtype=float), (error.shape[2],))
+    tol = _float_array("tol", tol)
+    if tol.ndim > 1 or tol.size not in (1, error.shape[2]):
+        raise InputError(f"tol must be one number or one per component ({error.shape[2]}); got shape {tol.shape}")
+    tol = np.broadcast_to(tol, (error.shape[2],))
     if not np.all(np.isfinite(tol)) or np.any(tol <= 0):
         raise InputError(f"tol must be finite and > 0 for every component; got {tol}")
     outside = np.any(np.abs(error) > tol, axis=2)  # (runs, n)

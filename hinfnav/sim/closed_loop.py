@@ -16,7 +16,7 @@ from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least
 from ..core.progress import bar_disabled
 from .montecarlo import SimulationResult, resolve_estimator
-from .truth import child_rngs, draw_noise, noise_models
+from .truth import child_rngs, draw_noise, noise_models, scenario_truth_model
 
 __all__ = ["simulate_closed_loop"]
 
@@ -47,7 +47,7 @@ def simulate_closed_loop(scenario, estimator, controller=None, *, noise="gaussia
     SimulationResult
         ``u`` is the input actually applied.
     """
-    model = scenario.truth_model(**conditions)
+    model = scenario_truth_model(scenario, conditions)
     estimator = resolve_estimator(estimator, scenario)
     if controller is None:
         if model.controller is None:

@@ -21,7 +21,7 @@ from ..core.progress import bar_disabled
 from ..design.result import SynthesisResult
 from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator
-from .truth import simulate_truth
+from .truth import scenario_truth_model, simulate_truth
 
 __all__ = ["SimulationResult", "available_memory_bytes", "history_bytes", "check_history_memory", "check_measurement_match", "run_estimator", "simulate", "simulate_batches", "resolve_estimator"]
 
@@ -149,7 +149,7 @@ def simulate_batches(scenario, estimator, *, noise="gaussian", measurement_noise
     depend on the batch size (run r always draws from the r-th child generator).
     Arguments as in :func:`simulate`.
     """
-    model = scenario.truth_model(**conditions)
+    model = scenario_truth_model(scenario, conditions)
     estimator = resolve_estimator(estimator, scenario)
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
@@ -178,7 +178,7 @@ def available_memory_bytes():
 
 def history_bytes(scenario, runs, **conditions):
     """Bytes the histories of ``runs`` runs take (x, x̂, u, y and a data-dependent covariance)."""
-    model = scenario.truth_model(**conditions)
+    model = scenario_truth_model(scenario, conditions)
     n, m_u, m = model.system.n, model.system.n_input, model.measurement.n_meas
     per_sample = 8 * (2 * n + m_u + m + n * n)
     return int(runs) * (model.n_steps + 1) * per_sample

@@ -15,6 +15,7 @@ histories at once. The same seed gives the same numbers, whatever the batch
 size.
 """
 
+import inspect
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,7 +24,7 @@ from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_vector
 from ..noise import ColoredNoise, make_noise
 
-__all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth"]
+__all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,6 +55,10 @@ class TruthModel:
     settings: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if not all(hasattr(self.system, a) for a in ("n", "dt")):
+            raise InputError(f"system must be a hinfnav system such as LinearSystem; got {type(self.system).__name__}")
+        if not all(hasattr(self.measurement, a) for a in ("n_state", "n_meas", "measure")):
+            raise InputError(f"measurement must be a hinfnav MeasurementModel; got {type(self.measurement).__name__}")
         object.__setattr__(self, "x0", as_vector("x0", self.x0, self.system.n))
         object.__setattr__(self, "n_steps", as_int_at_least("n_steps", self.n_steps, 1))
         if self.measurement.n_state != self.system.n:
@@ -92,6 +97,29 @@ class Truth:
     settings: dict = field(default_factory=dict)
     state: object = None
     measurement: object = None
+
+
+def scenario_truth_model(scenario, conditions):
+    """``scenario.truth_model(**conditions)``, after checking that ``scenario`` is one and knows every condition.
+
+    Raises :class:`InputError` naming an unknown condition (e.g. a misspelt
+    ``maneuvre=``) and the ones the scenario takes, instead of a TypeError.
+    """
+    build = getattr(scenario, "truth_model", None)
+    if not callable(build) or not hasattr(scenario, "xhat0"):
+        raise InputError(f"scenario must offer truth_model(**conditions) and xhat0 (such as hinfnav.Scenario); "
+                         f"got {type(scenario).__name__}")
+    try:
+        params = inspect.signature(build).parameters.values()
+    except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
+        params = None
+    if params is not None and not any(p.kind is p.VAR_KEYWORD for p in params):
+        names = [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+        unknown = sorted(set(conditions) - set(names))
+        if unknown:
+            raise InputError(f"unknown condition {', '.join(map(repr, unknown))} for {type(scenario).__name__}; "
+                             f"its conditions are: {', '.join(names) or 'none'}")
+    return build(**conditions)
 
 
 def child_rngs(seed, runs):

@@ -19,6 +19,8 @@ Norm-bounded structure (10)–(11) of Section 4: ``ΔA₁ = H_a F(δ) E_a`` with
 ``F(δ)ᵀF(δ) ≤ I`` for ``|δ| ≤ δ̄``.
 """
 
+import math
+
 import numpy as np
 
 from ..core.exceptions import InputError
@@ -57,6 +59,8 @@ def hill_matrices(omega, mass):
     """
     omega = as_real("omega", omega)
     mass = as_positive("mass", mass)
+    if not math.isfinite(omega * omega):
+        raise InputError(f"omega = {omega:g} rad/s is too large: ω² overflows")
     A0 = np.zeros((6, 6))
     A0[:3, 3:] = np.eye(3)
     A0[3, 0] = 3.0 * omega**2
@@ -113,6 +117,8 @@ def uncertainty_structure(omega0, delta_bar):
     H[3, 4] = 2.0
     H[4, 3] = -2.0
     H[5, 2] = -omega0
+    if not (math.isfinite(delta_bar * delta_bar) and math.isfinite(omega0 * (2 * delta_bar + delta_bar * delta_bar))):
+        raise InputError(f"delta_bar = {delta_bar:g} is too large: ω₀(2δ̄ + δ̄²) overflows")
     E = np.zeros((6, 6))
     E[0, 0] = E[2, 2] = omega0 * (2 * delta_bar + delta_bar**2)
     E[3, 3] = E[4, 4] = omega0 * delta_bar

@@ -9,6 +9,9 @@ residual. Models act on batches: ``x`` of shape (..., n).
 * :class:`RangeAzimuthElevation` — range ρ, azimuth α, elevation β of the
   relative position, the direct measurement behind (7), with its Jacobian and
   its inverse (the indirect position measurement);
+* :class:`ConvertedPosition` — a range/angle reading converted to position,
+  the indirect measurement as a filter uses it, with covariance J R Jᵀ at
+  each reading;
 * :class:`Saturated` — wraps a model and clips each channel to
   [lower, upper], reporting which channels saturated.
 """
@@ -16,12 +19,13 @@ residual. Models act on batches: ``x`` of shape (..., n).
 import numpy as np
 
 from ..core.exceptions import InputError
-from ..core.validation import as_matrix, as_positive
+from ..core.validation import as_int_at_least, as_matrix, as_positive
 
 __all__ = [
     "MeasurementModel",
     "LinearMeasurement",
     "RangeAzimuthElevation",
+    "ConvertedPosition",
     "Saturated",
     "range_angles",
     "range_angles_jacobian",
@@ -248,6 +252,10 @@ def position_from_range_angles(m, C_bl=None):
     m = np.asarray(m, dtype=float)
     if m.ndim < 1 or m.shape[-1] != 3:
         raise InputError(f"m must have shape (..., 3) (range, azimuth, elevation); got {m.shape}")
+    if not np.all(np.isfinite(m)):
+        raise InputError("m must contain only finite numbers; it has NaN or inf entries")
+    if np.any(m[..., 0] < 0):
+        raise InputError(f"m: the range (first entry) must be >= 0 m; its smallest is {m[..., 0].min():g}")
     rho, a, b = m[..., 0], m[..., 1], m[..., 2]
     pb = np.stack([rho * np.cos(b) * np.cos(a), rho * np.cos(b) * np.sin(a), -rho * np.sin(b)], axis=-1)
     return pb @ _check_C_bl(C_bl)  # C_bl⁻¹ = C_blᵀ, applied to row vectors
@@ -269,6 +277,7 @@ class RangeAzimuthElevation(MeasurementModel):
     """
 
     def __init__(self, n_state, sigma_range, sigma_angle, C_bl=None):
+        n_state = as_int_at_least("n_state", n_state, 3)  # the first three components are the position
         self.sigma_range = as_positive("sigma_range", sigma_range)
         self.sigma_angle = as_positive("sigma_angle", sigma_angle)
         self.C_bl = _check_C_bl(C_bl)
@@ -328,8 +337,12 @@ class Saturated(MeasurementModel):
         if not isinstance(model, MeasurementModel):
             raise InputError(f"model must be a MeasurementModel; got {type(model).__name__}")
         m = model.n_meas
-        lo = np.broadcast_to(np.asarray(lower, dtype=float), (m,)).copy()
-        hi = np.broadcast_to(np.asarray(upper, dtype=float), (m,)).copy()
+        lo, hi = (np.asarray(b, dtype=float) for b in (lower, upper))
+        for name, b in (("lower", lo), ("upper", hi)):
+            if b.ndim > 1 or b.size not in (1, m):
+                raise InputError(f"{name} must be one bound or one per channel ({m}); got shape {b.shape}")
+        lo = np.broadcast_to(lo, (m,)).copy()
+        hi = np.broadcast_to(hi, (m,)).copy()
         if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo >= hi):
             raise InputError(f"lower must be < upper in every channel; got lower={lo}, upper={hi}")
         super().__init__(model.n_state, model.D, model.labels, model.units)
@@ -361,3 +374,84 @@ def as_measurement_model(value, name="measurement"):
         raise InputError(f"{name} must be a hinfnav MeasurementModel; got {type(value).__name__}")
     return value
 
+
+
+# ---------------------------------------------------------------------------
+# the indirect (converted) position measurement, (7)-(8) of Sun et al. (2011),
+# (20)-(22) of Shi & Wang (2018)
+# ---------------------------------------------------------------------------
+
+
+class ConvertedPosition(MeasurementModel):
+    """A range/azimuth/elevation reading converted to position: the indirect measurement.
+
+    The sensor reads ``m = (ρ, α, β) + v`` with ``cov(v) = R = diag(σ_ρ², σ_α², σ_β²)``.
+    A filter on the indirect measurement uses the converted position
+    ``z = g(m) = C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)`` ((7) of Sun
+    et al. 2011) as a linear measurement of the state,
+
+    .. math::
+
+        z = [I_3 \\; 0]\\, x + e, \\qquad \\operatorname{cov}(e) \\approx J(m) R J(m)^T,
+
+    with ``J = ∂g/∂m`` at the reading (first order; (21)–(22) of Shi & Wang
+    2018, "Z = HX + DV, E[DV (DV)ᵀ] = D R Dᵀ"). Its noise covariance depends
+    on the reading: :meth:`noise_covariance` gives ``R_k`` for each y_k, and
+    :class:`hinfnav.estimators.ExtendedKalmanFilter` uses it when the model
+    has it (then each run carries its own covariance).
+
+    The readings ``y`` are the sensor's (ρ, α, β) — ``labels``, ``units``,
+    ``D`` and :meth:`measure` are the sensor's, so one simulated truth serves
+    filters on the direct and on the converted measurement — while
+    :meth:`function` and :meth:`jacobian` are those of the position
+    ``[I 0] x``, and :meth:`residual` converts the reading:
+    ``residual(y, ŷ) = g(y) − ŷ``.
+
+    Parameters
+    ----------
+    sensor : RangeAzimuthElevation
+        The sensor whose readings are converted.
+    """
+
+    linear = True
+
+    def __init__(self, sensor):
+        if not isinstance(sensor, RangeAzimuthElevation):
+            raise InputError(f"sensor must be a RangeAzimuthElevation model; got {type(sensor).__name__}")
+        super().__init__(sensor.n_state, sensor.D, sensor.labels, sensor.units)
+        self.sensor = sensor
+        H = np.zeros((3, sensor.n_state))
+        H[:, :3] = np.eye(3)
+        H.setflags(write=False)
+        self.H = H
+
+    @property
+    def R(self):
+        """Not defined: the converted position's covariance depends on the reading (see :meth:`noise_covariance`)."""
+        raise InputError("a converted measurement has no constant R: its covariance J R Jᵀ depends on the reading "
+                         "(use noise_covariance(y), or give the filter an explicit R)")
+
+    def function(self, x):
+        """The position ``[I 0] x``, shape (..., 3), m."""
+        return self.check_state(x) @ self.H.T
+
+    def jacobian(self, x):
+        """``[I 0]`` broadcast over the batch, shape (..., 3, n)."""
+        x = self.check_state(x)
+        return np.broadcast_to(self.H, x.shape[:-1] + self.H.shape)
+
+    def convert(self, y):
+        """The indirect position measurement ``g(y)`` of readings (ρ, α, β), shape (..., 3), m."""
+        return self.sensor.inverse(y)
+
+    def residual(self, y, yhat):
+        """``g(y) − ŷ``: the converted reading minus a predicted position, m."""
+        return self.convert(y) - np.asarray(yhat, dtype=float)
+
+    def measure(self, x, v):
+        """The sensor's noisy readings (ρ, α, β) of a batch (see :meth:`RangeAzimuthElevation.measure`)."""
+        return self.sensor.measure(x, v)
+
+    def noise_covariance(self, y):
+        """``R_k = J(y) R J(y)ᵀ`` of the converted position at readings ``y``, shape (..., 3, 3), m²."""
+        return self.sensor.position_covariance(y)

@@ -39,12 +39,22 @@ class StateSpec:
     axis_names: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        for name in ("labels", "units"):
+            if isinstance(getattr(self, name), str) or not hasattr(getattr(self, name), "__iter__"):
+                raise InputError(f"{name} must be a sequence of strings, one per state component; got {getattr(self, name)!r}")
+        if not hasattr(self.groups, "items"):
+            raise InputError(f"groups must be a dict name -> component indices; got {self.groups!r}")
+        if not hasattr(self.axis_names, "get"):
+            raise InputError(f"axis_names must be a dict group -> axis names; got {self.axis_names!r}")
         labels, units = tuple(str(s) for s in self.labels), tuple(str(s) for s in self.units)
         if len(labels) != len(units) or not labels:
             raise InputError(f"labels and units must have the same, non-zero length; got {len(labels)} and {len(units)}")
         groups = {}
         for name, idx in dict(self.groups).items():
-            idx = tuple(int(i) for i in idx)
+            try:
+                idx = tuple(int(i) for i in idx)
+            except (TypeError, ValueError):
+                raise InputError(f"group {name!r} must list component indices (integers); got {idx!r}") from None
             if not idx or min(idx) < 0 or max(idx) >= len(labels):
                 raise InputError(f"group {name!r} must list component indices in 0..{len(labels) - 1}; got {idx}")
             if len({units[i] for i in idx}) != 1:

@@ -10,17 +10,21 @@ this scenario; here the scenario's uncertain model, its diagonal F_Δa and the
 import dataclasses
 from dataclasses import dataclass
 
+import control
 import numpy as np
+import scipy.optimize
 from tqdm import tqdm
 
 from ...analysis.error_system import error_system, worst_case_norm
 from ...analysis.norms import channel_norms, hinf_norm
 from ...analysis.observer import observer_form
-from ...core.exceptions import InputError
-from ...core.validation import as_int_at_least, as_nonnegative
+from ...core.exceptions import InputError, UnstablePlantError
+from ...core.linalg import spectral_radius
+from ...core.validation import as_int_at_least, as_nonnegative, check_keywords
 from ...core.progress import bar_disabled
 from ...core.provenance import provenance
 from ...design import io as design_io
+from ...design.result import SynthesisResult
 from ...design.robust_hinf import synthesize
 from ...design.samples import SampleSet
 from ...lmi.conditioning import prepare_uncertainty
@@ -41,9 +45,15 @@ __all__ = [
     "compare_with_published",
     "save_design",
     "load_design",
+    "small_gain_bounds",
+    "small_gain_crossing",
 ]
 
 
+
+
+#: Options of :func:`design_for_scenario` passed on to :func:`synthesize` (the δ grid sets the samples).
+_SYNTHESIS_OPTIONS = ("dt", "structure", "n_random_samples", "seed", "form", "options", "solver")
 
 
 def delta_grid(delta_bar, points=21):
@@ -105,13 +115,19 @@ def design_for_scenario(scenario=None, delta_bar=None, *, delta_points=21, **opt
         raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     delta_bar = scenario.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
     delta_points = as_int_at_least("delta_points", delta_points, 2)
+    check_keywords("design option", options, _SYNTHESIS_OPTIONS)
     system = scenario.design_model(delta_bar)
     samples = delta_samples(delta_bar, delta_points)
     options.setdefault("structure", "diagonal")
     options.setdefault("dt", scenario.dt)
-    result = synthesize(
-        system.A, system.B, system.C, system.D, system.L, system.H, system.E, uncertainty_samples=samples, **options
-    )
+    try:
+        result = synthesize(
+            system.A, system.B, system.C, system.D, system.L, system.H, system.E, uncertainty_samples=samples, **options
+        )
+    except UnstablePlantError as exc:
+        if delta_bar > 0 and spectral_radius(system.A) < 1.0:  # stable at δ = 0: it is δ̄ that is too large
+            raise UnstablePlantError(f"delta_bar = {delta_bar:g} is too large for this scenario: {exc}") from None
+        raise
     if samples is None:
         # a nominal design is checked at δ = 0 only; record it so reports can say so
         result = _with_grid(result, delta_bar, delta_grid(delta_bar, delta_points))
@@ -196,7 +212,11 @@ def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **
     -------
     GammaSweep
     """
+    if isinstance(delta_bars, str) or not hasattr(delta_bars, "__iter__"):
+        raise InputError(f"delta_bars must be a sequence of bounds >= 0; got {delta_bars!r}")
     dbs = np.array([as_nonnegative("delta_bars entry", d) for d in delta_bars], dtype=float)
+    if dbs.size == 0:
+        raise InputError("delta_bars must hold at least one uncertainty bound")
     results = []
     for d in tqdm(dbs, disable=bar_disabled(progress), desc="γ*(δ̄)", unit="design"):
         results.append(design_for_scenario(scenario, d, **options))
@@ -234,6 +254,7 @@ def design_report_from(res):
         "form": res.form,
         "gamma": res.gamma,
         "lmi_gamma": res.lmi_gamma,
+        "lmi20_gamma": float(res.variables.get("lmi20_gamma", res.gamma)),
         "verified_norm": res.verified_norm,
         "worst_delta": res.worst_delta,
         "spectral_radius": res.spectral_radius,
@@ -275,8 +296,13 @@ def format_design_report(report):
     lines = [
         f"Robust H∞ filter, Corollary 1 of Sun et al. (2011), δ̄ = {report['delta_bar']:g}",
         f"  filter form        : {form_text}",
-        f"  certified γ        : {report['gamma']:.8g}   (LMI (20) verified by eigenvalues at the returned filter)",
+        f"  certified γ        : {report['gamma']:.8g}   "
+        + ("(full Lyapunov matrix for the returned filter, robust bounded real LMI)"
+           if report.get("lmi20_gamma", report["gamma"]) > report["gamma"]
+           else "(LMI (20) verified by eigenvalues at the returned filter)"),
         f"  solver γ           : {report['lmi_gamma']:.8g}   ({report['solver']}, {report['method']})",
+    ] + ([f"  LMI (20) level     : {report['lmi20_gamma']:.8g}   (restricted Lyapunov matrix diag(R − S, S))"]
+         if form == "observer" and "lmi20_gamma" in report else []) + [
         f"  worst sampled norm : {report['verified_norm']:.8g}   at δ = {report['worst_delta']:.6g} "
         f"({len(report['deltas_checked'])} δ checked, slycot ab13dd)",
         f"  spectral radius    : {report['spectral_radius']:.8g}   (error system, worst sample)",
@@ -328,7 +354,9 @@ def compare_with_published(scenario=None, solver=None, delta_points=21, design=N
         ``ratio`` = published worst norm / optimal certified γ;
         ``excess_percent``; ``deltas``; ``design`` (the SynthesisResult).
     """
-    scenario = Scenario() if scenario is None else scenario
+    scenario = _scenario(scenario)
+    if design is not None and not isinstance(design, SynthesisResult):
+        raise InputError(f"design must be a hinfnav SynthesisResult (from design_for_scenario); got {type(design).__name__}")
     pub = published_filter()
     db = pub.delta_bar
     if design is None:
@@ -381,6 +409,13 @@ def compare_with_published(scenario=None, solver=None, delta_points=21, design=N
 
 
 
+def _scenario(scenario):
+    scenario = Scenario() if scenario is None else scenario
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
+    return scenario
+
+
 def save_design(result, path, scenario=None):
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
 
@@ -388,7 +423,10 @@ def save_design(result, path, scenario=None):
     the scenario at the design's δ̄ (with its fingerprint and T), the design
     options and provenance (:mod:`hinfnav.design.io`). Returns the path.
     """
-    scenario = Scenario() if scenario is None else scenario
+    if not isinstance(result, SynthesisResult):
+        raise InputError(f"result must be a hinfnav SynthesisResult (from design_for_scenario); got {type(result).__name__}")
+    scenario = _scenario(scenario)
+    design_io.check_design_path(path)
     delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
     system = scenario.design_model(delta_bar)
     options = {"delta_bar": delta_bar, "form": result.form, "structure": result.structure, "solver": result.solver}
@@ -405,9 +443,58 @@ def load_design(path, scenario=None):
         If the file is not a design, was edited, or was designed for another
         system (another T, B, D, K, …): the message names what differs.
     """
-    scenario = Scenario() if scenario is None else scenario
+    scenario = _scenario(scenario)
     result, system, _ = design_io.load_design(path)
     delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
     design_io.check_design_system(system, system.dt, scenario.design_model(delta_bar), scenario.dt,
                                   what="the scenario")
     return result
+
+
+def small_gain_bounds(delta_bars, scenario=None):
+    """The small-gain number ``‖E(zI − A)⁻¹H‖∞`` of the design model across δ̄.
+
+    With one multiplier λ (Lemma 2), the γ-free part of LMI (20) asks the
+    plant ``A + H F E`` to be quadratically stable for every F the factors
+    admit; for F any contraction (``structure="full"``) that holds iff
+    ``‖E(zI − A)⁻¹H‖∞ < 1`` (bounded real lemma for ``(A, H√λ⁻¹, E√λ)``,
+    small-gain theorem), whatever the filter. Computed (SLICOT ab13dd) for
+    the factors as printed (``H = T·H_a``, ``E = E_a``; a common balancing
+    scalar does not change the number) and for the channel-balanced ones
+    the synthesis uses with a diagonal F, ``diag(s)⁻¹ E (zI − A)⁻¹ H diag(s)``
+    (:func:`hinfnav.lmi.conditioning.prepare_uncertainty`).
+
+    Parameters
+    ----------
+    delta_bars : sequence of float
+        Uncertainty bounds δ̄ > 0.
+    scenario : Scenario, optional
+
+    Returns
+    -------
+    dict
+        ``delta_bars``, ``printed``, ``balanced`` (ndarrays, dimensionless).
+    """
+    scenario = _scenario(scenario)
+    dbs = np.array([as_nonnegative("delta_bars entry", d) for d in delta_bars], dtype=float)
+    if np.any(dbs == 0):
+        raise InputError("delta_bars entries must be > 0 (δ̄ = 0 has no uncertainty, no small-gain number)")
+    out = {"delta_bars": dbs, "printed": [], "balanced": []}
+    for d in dbs:
+        s = scenario.design_model(d)
+        for key, structure in (("printed", "full"), ("balanced", "diagonal")):
+            H, E, _ = prepare_uncertainty(s.H, s.E, structure)
+            sys_ = control.ss(s.A, H, E, np.zeros((E.shape[0], H.shape[1])), scenario.dt)
+            out[key].append(hinf_norm(sys_))
+    out["printed"], out["balanced"] = np.array(out["printed"]), np.array(out["balanced"])
+    return out
+
+
+def small_gain_crossing(scenario=None, bracket=(0.5, 5.0)):
+    """The δ̄ at which the printed factors' small-gain number reaches 1 (LMI (20) with them turns infeasible).
+
+    Root of ``small_gain_bounds([δ̄])["printed"] − 1`` by Brent's method in
+    ``bracket`` (to 1e-6 in δ̄).
+    """
+    f = lambda d: small_gain_bounds([d], scenario)["printed"][0] - 1.0  # noqa: E731
+    return float(scipy.optimize.brentq(f, *bracket, xtol=1e-6))

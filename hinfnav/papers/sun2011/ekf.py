@@ -46,10 +46,12 @@ range/angle model each run carries its own covariance.
 ``ExtendedKalmanFilter`` run by run.
 """
 
+import inspect
+
 import numpy as np
 
 from ...core.exceptions import InputError
-from ...core.validation import as_choice, as_nonnegative, as_positive
+from ...core.validation import as_choice, as_nonnegative, as_positive, check_keywords
 from ...estimators.kalman import ExtendedKalmanFilter
 from ...systems.measurements import RangeAzimuthElevation, wrap_angle
 from .constants import DEFAULT_P0_STD, DEFAULT_SIGMA_ANGLE, DEFAULT_SIGMA_RANGE
@@ -212,6 +214,7 @@ def build_ekf(scenario, known_input=False, **options):
     """
     if not isinstance(known_input, (bool, np.bool_)):
         raise InputError(f"known_input must be True or False; got {known_input!r}")
+    check_keywords("EKF option", options, _EKF_OPTIONS)
     dynamics = options.pop("dynamics", None)
     if dynamics is None:
         dynamics = "applied_thrust" if known_input else "unforced"
@@ -223,6 +226,10 @@ def build_ekf(scenario, known_input=False, **options):
                 "only dynamics='applied_thrust' uses the applied thrust"
             )
     return EKF(scenario, dynamics=dynamics, **options)
+
+
+#: Keyword options of :func:`EKF` (what :func:`build_ekf` and ``make_estimator("ekf", ...)`` pass on).
+_EKF_OPTIONS = tuple(p for p in inspect.signature(EKF).parameters if p != "scenario")
 
 
 def range_angle_measurements(x, rng, sigma_range=DEFAULT_SIGMA_RANGE, sigma_angle=DEFAULT_SIGMA_ANGLE, C_bl=None):

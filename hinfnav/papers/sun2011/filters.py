@@ -20,6 +20,8 @@ name                       estimator
 =========================  ===============================================
 """
 
+import numpy as np
+
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
 from ...estimators.registry import register_estimator
@@ -84,10 +86,20 @@ def make_estimator(name, scenario, **options):
         raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     as_choice("filter", name, FILTER_NAMES)
     if name in ("published", "published_closed_loop"):
+        if options:
+            raise InputError(f"filter {name!r} is the printed filter and takes no options; got {', '.join(sorted(options))}")
         pub = published_filter()
         return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"),
                                  design_dt=pub.dt)
     if name.startswith("designed"):
+        n = scenario.x0.size
+        if scenario.L.shape != (n, n) or not np.linalg.cond(scenario.L) < 1e12:
+            raise InputError(
+                f"filter {name!r} estimates the whole state (x̂ = C_F x_f), so the scenario's L must be square and "
+                f"invertible; got L of shape {scenario.L.shape[0]}x{scenario.L.shape[1]}"
+                + ("" if scenario.L.shape != (n, n) else f" with condition number {np.linalg.cond(scenario.L):.3g}")
+                + " (design_for_scenario designs for any L)"
+            )
         if name.startswith("designed_observer"):
             options.setdefault("form", "observer")
         res = design_for_scenario(scenario, **options)

@@ -131,6 +131,9 @@ def kalman_limit(scenario, maneuver=True, discretization="exact"):
     if not isinstance(maneuver, (bool, np.bool_)):
         raise InputError(f"maneuver must be True or False; got {maneuver!r}")
     as_choice("discretization", discretization, ("exact", "euler"))
+    if np.linalg.matrix_rank(scenario.D) < scenario.D.shape[0]:
+        raise InputError("the scenario's D must have full row rank: the Kalman limit needs R = D Dᵀ positive definite "
+                         f"(D has rank {np.linalg.matrix_rank(scenario.D)} of {scenario.D.shape[0]})")
     Phi, Gamma = scenario.truth_matrices(0.0, discretization)
     A = Phi + Gamma @ scenario.K if maneuver else Phi
     P, Pf, gain = steady_state_kalman(A, measurement_matrix(), scenario.B @ scenario.B.T, scenario.D @ scenario.D.T)

@@ -14,7 +14,8 @@ from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...metrics.streaming import monte_carlo_statistics
 from .designs import load_design
-from .filters import make_estimator
+from ...estimators.registry import build_estimator
+from .filters import FILTER_NAMES, make_estimator
 from .scenario import Scenario
 
 __all__ = ["MAX_RUNS", "simulate_report", "format_simulate_report"]
@@ -66,7 +67,7 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
     else:
         if verbatim:
             raise InputError("verbatim applies to --design only (the registered names say how each filter runs)")
-        est = make_estimator(filter, scenario)
+        est = make_estimator(filter, scenario) if filter in FILTER_NAMES else build_estimator(filter, scenario)
         label = filter
     win = scenario.rms_window_s
     stats = monte_carlo_statistics(scenario, est, windows={"main": win}, runs=runs, seed=seed, noise=noise,
@@ -130,7 +131,7 @@ def format_simulate_report(rep):
         for label, key in (("position (m)", "pos_m"), ("velocity (m/s)", "vel_mps")):
             lo, hi = rep[f"mc_ci95_{key}"]
             lines.append(f"{'95% CI of mean, ' + label.split()[0][:3]:22}"
-                         + "".join(f"{f'{a:.4g} – {b:.4g}':>16}" for a, b in zip(lo, hi)))
+                         + "".join(f"{f'{a:.3g}–{b:.3g}':>16}" for a, b in zip(lo, hi)))
     lines.append(f"Table 1 cell: {rep['cell_pos_m']:.4g} m, {rep['cell_vel_mps']:.4g} m/s (run 0)"
                  + (f"; mean of {runs}: {rep['cell_mc_mean_pos_m']:.4g} m, {rep['cell_mc_mean_vel_mps']:.4g} m/s"
                     if runs > 1 else ""))

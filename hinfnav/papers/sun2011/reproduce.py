@@ -6,7 +6,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...core.validation import as_int_at_least
+from ...core.validation import as_int_at_least, as_seed
 from ...core.outputs import to_json, write_json
 from ...core.progress import bar_disabled
 from ...core.provenance import provenance
@@ -88,7 +88,10 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
         The summary written to ``summary.json``.
     """
     scenario = Scenario() if scenario is None else scenario
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     runs = as_int_at_least("runs", runs, 1)
+    as_seed("seed", seed)  # before the designs, not after them
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     prov = provenance(seed=seed, runs=runs, paper="sun2011")

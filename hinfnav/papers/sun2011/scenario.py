@@ -154,6 +154,12 @@ class Scenario:
         delta = as_real("delta", delta)
         if delta <= -1:
             raise InputError(f"delta must be > -1 (the orbital rate ω₀(1+δ) must be positive); got {delta}")
+        limit = np.pi / (self.omega0 * self.dt) - 1.0
+        if not delta < limit:
+            raise InputError(
+                f"delta must be < {limit:.6g} at T = {self.dt:g} s; got {delta:g}: the orbital rate ω₀(1+δ) would turn "
+                "through half a revolution or more per sample (ω T ≥ π), so the sampled Hill model aliases"
+            )
         A0, G0 = self.continuous_matrices(delta)
         return discretize(A0, G0, self.dt, discretization)
 

@@ -143,7 +143,8 @@ def format_robustness_table(rows):
     return "\n".join(lines)
 
 
-def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest")):
+def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest"),
+                          delta_bar=None):
     """Monte Carlo RMS errors of the published and the re-synthesized filters.
 
     The filters run on the same simulated truths (:func:`hinfnav.sim.simulate_truth`),
@@ -158,7 +159,7 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
     ----------
     design : SynthesisResult, optional
         The general (LMI (20)) design; default :func:`design_for_scenario`
-        at δ̄ = 0.05.
+        at ``delta_bar``.
     scenario : Scenario, optional
     runs : int, optional
         Monte Carlo runs per case.
@@ -166,9 +167,12 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
     observer : SynthesisResult or bool, optional
         A third filter, in observer form (:func:`synthesize` with
         ``form="observer"``): a result to reuse, or True to design it at
-        the δ̄ of ``design`` (0.05 if unset). None or False: two filters.
+        the δ̄ of ``design`` (``delta_bar`` if unset). None or False: two filters.
     starts : sequence of {"paper", "rest"}, optional
         Initial conditions to simulate.
+    delta_bar : float, optional
+        Uncertainty bound δ̄ of (5) of the filters designed here; default
+        ``scenario.delta_bar`` (0.05, the published filter's).
 
     Returns
     -------
@@ -193,12 +197,13 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
           stationary covariance.
     """
     scenario = Scenario() if scenario is None else scenario
-    design = design_for_scenario(scenario, 0.05) if design is None else design
+    delta_bar = scenario.delta_bar if delta_bar is None else delta_bar
+    design = design_for_scenario(scenario, delta_bar) if design is None else design
     starts = [as_choice("start", st, ("paper", "rest")) for st in starts]
     pub = published_filter()
     filters = {"published": (pub.A_F, pub.B_F, pub.C_F), "re-synthesized": (design.A_F, design.B_F, design.C_F)}
     if observer is True:
-        db = 0.05 if design.delta_bar is None else design.delta_bar
+        db = delta_bar if getattr(design, "delta_bar", None) is None else design.delta_bar
         observer = design_for_scenario(scenario, db, form="observer")
     if observer is not None and observer is not False:
         filters["observer form"] = (observer.A_F, observer.B_F, observer.C_F)

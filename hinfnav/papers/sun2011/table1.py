@@ -24,8 +24,10 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ...core.validation import as_int_at_least
+from ...core.exceptions import InputError
+from ...core.validation import as_int_at_least, as_nonnegative, as_seed
 from ...core.progress import bar_disabled
+from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
 from ...sim.montecarlo import run_estimator
 from ...sim.truth import simulate_truth
@@ -35,8 +37,8 @@ from .filters import lti_from_matrices, make_estimator
 from .limits import kalman_limit
 from .scenario import Scenario
 
-__all__ = ["TABLE_FILTERS", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows", "format_table1",
-           "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
+__all__ = ["TABLE_FILTERS", "filter_labels", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows",
+           "format_table1", "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
 
 #: Filters of the reproduced table: key -> (label, builder name)
 TABLE_FILTERS = {
@@ -48,6 +50,13 @@ TABLE_FILTERS = {
 }
 
 CASES = {"no_maneuver": False, "maneuver": True}
+
+
+def filter_labels(delta_bar=0.05):
+    """:data:`TABLE_FILTERS` with the designed filter's label at its uncertainty bound ``delta_bar``."""
+    labels = dict(TABLE_FILTERS)
+    labels["hinf_designed"] = f"H∞, designed here (δ̄ = {float(delta_bar):g})"
+    return labels
 
 
 def _estimators(scenario, designed, maneuver, observer=None):
@@ -151,14 +160,25 @@ FOOTNOTES = {
 EKF_WINDOWS = (("0-500 s", (0.0, 500.0)), ("100-500 s", (100.0, 500.0)), ("500-1000 s", (500.0, 1000.0)))
 
 
-def row_command(key, maneuver, runs, seed):
-    """The command line that reproduces a row of the table (same seed, same numbers)."""
+def row_command(key, maneuver, runs, seed, delta_bar=0.05):
+    """The command line that reproduces a row of the table (same seed, same numbers).
+
+    ``delta_bar`` is the uncertainty bound of the designed rows; away from the
+    CLI's default 0.05 they are designed and saved first, then run with ``--design``.
+    """
     name = ROW_FILTERS[key][bool(maneuver)]
     flag = "" if maneuver else " --no-maneuver"
-    return f"python -m hinfnav simulate --filter {name}{flag} --runs {runs} --seed {seed} --json"
+    tail = f"{flag} --runs {runs} --seed {seed} --json"
+    if key in ("hinf_designed", "hinf_observer") and float(delta_bar) != 0.05:
+        form, file = (" --form observer", "observer.json") if key == "hinf_observer" else ("", "designed.json")
+        verbatim = " --verbatim" if maneuver else ""
+        return (f"python -m hinfnav design --delta-bar {float(delta_bar)!r}{form} --save {file} && "
+                f"python -m hinfnav simulate --design {file}{verbatim}{tail}")
+    return f"python -m hinfnav simulate --filter {name}{tail}"
 
 
-def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False, batch_size=100):
+def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False, batch_size=100,
+           delta_bar=None):
     """Compute the reproduced Table 1.
 
     Parameters
@@ -169,15 +189,19 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
         Monte Carlo runs per case (≥ 1; 100 or more for the interval).
     seed : int
     designed : SynthesisResult, optional
-        The δ̄ = 0.05 filter from :func:`hinfnav.synthesize`; designed here when
-        None (about a second).
+        The filter from :func:`hinfnav.synthesize` (Corollary 1); designed here
+        at ``delta_bar`` when None (about a second).
     observer : SynthesisResult, optional
-        The δ̄ = 0.05 filter designed in observer form (an extension of the
-        paper); designed here when None.
+        The filter designed in observer form (an extension of the paper);
+        designed here at ``delta_bar`` when None.
     progress : bool
     batch_size : int
         Runs simulated together; memory is that of one batch (about 50 MB per
         100 runs), whatever ``runs``; the numbers do not depend on it.
+    delta_bar : float, optional
+        Uncertainty bound δ̄ of (5) of the filters designed here; default
+        ``scenario.delta_bar`` (0.05, the published filter's). The labels and
+        commands of the designed rows follow the δ̄ of the filters used.
 
     Returns
     -------
@@ -187,10 +211,17 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     scenario = Scenario() if scenario is None else scenario
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
+    as_seed("seed", seed)
+    delta_bar = scenario.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
+    for key, f in (("designed", designed), ("observer", observer)):
+        if f is not None and not isinstance(f, SynthesisResult):
+            raise InputError(f"{key} must be a hinfnav SynthesisResult (from design_for_scenario); got {type(f).__name__}")
     if designed is None:
-        designed = design_for_scenario(scenario, delta_bar=0.05)
+        designed = design_for_scenario(scenario, delta_bar=delta_bar)
     if observer is None:
-        observer = design_for_scenario(scenario, delta_bar=0.05, form="observer")
+        observer = design_for_scenario(scenario, delta_bar=delta_bar, form="observer")
+    bounds = {k: float(delta_bar if getattr(f, "delta_bar", None) is None else f.delta_bar)
+              for k, f in (("hinf_designed", designed), ("hinf_observer", observer))}
     win = scenario.rms_window_s
     cells, ekf_windows, klim = {}, {}, {}
     keys = list(_estimators(scenario, designed, True, observer))
@@ -218,7 +249,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
                 joined = [np.concatenate([p[i] for p in parts]) for i in range(4)]
                 cell = cell_from_values(joined[0], joined[1], joined[2][0], joined[3][0])
                 if w == "main":
-                    cell["cli"] = row_command(key, maneuver, runs, seed)
+                    cell["cli"] = row_command(key, maneuver, runs, seed, bounds.get(key, 0.05))
                     if (case, key) in FOOTNOTES:
                         cell["note"] = FOOTNOTES[case, key]
                     cells[case][key] = cell
@@ -243,6 +274,8 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
         "designed_gamma": float(designed.gamma),
         "designed_lmi_gamma": float(designed.lmi_gamma),
         "observer_gamma": float(observer.gamma),
+        "designed_delta_bar": bounds["hinf_designed"],
+        "observer_delta_bar": bounds["hinf_observer"],
     }
     return Table1(cells=cells, ekf_windows=ekf_windows, kalman_limit=klim, settings=settings)
 
@@ -276,7 +309,8 @@ def table1_rows(tab):
     """
     rows = []
     for case in CASES:
-        for key, label in [("paper_ekf", "paper: EKF"), ("paper_hinf", "paper: H∞")] + list(TABLE_FILTERS.items()):
+        labels = filter_labels(tab.settings.get("designed_delta_bar", 0.05))
+        for key, label in [("paper_ekf", "paper: EKF"), ("paper_hinf", "paper: H∞")] + list(labels.items()):
             c = tab.cells[case].get(key)
             if c is None:
                 continue

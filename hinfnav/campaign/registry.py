@@ -1,0 +1,102 @@
+"""Scenarios by name, for campaigns: each paper registers the factory of its scenario.
+
+A campaign names its scenario (the key of its paper) and the scenario's settings
+(``mass``, ``dt``, …); :func:`build_scenario` makes it with
+``factory(**settings)``. The factory's keyword parameters are the settings a
+campaign grid may vary; the parameters of the scenario's
+``truth_model(**conditions)`` are its conditions (``maneuver``, ``delta``, …).
+"""
+
+import importlib
+import inspect
+from dataclasses import dataclass
+
+from ..core.exceptions import InputError
+
+__all__ = ["register_scenario", "registered_scenarios", "scenario_entry", "build_scenario", "scenario_parameters",
+           "condition_parameters", "load_providers", "PROVIDERS"]
+
+
+@dataclass(frozen=True)
+class _ScenarioEntry:
+    name: str
+    factory: object
+    description: str
+
+
+_SCENARIOS = {}
+
+
+def register_scenario(name, factory, *, description=""):
+    """Register ``factory(**settings) -> scenario`` under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The name a campaign uses (the paper's key).
+    factory : callable
+        Returns an object with ``truth_model(**conditions)`` and ``xhat0``
+        (the scenario protocol of :mod:`hinfnav.sim`); called with no
+        argument it gives the paper's scenario.
+    description : str
+    """
+    if not isinstance(name, str) or not name:
+        raise InputError(f"scenario name must be a non-empty string; got {name!r}")
+    if not callable(factory):
+        raise InputError(f"factory of scenario {name!r} must be callable; got {type(factory).__name__}")
+    _SCENARIOS[name] = _ScenarioEntry(name, factory, description)
+
+
+def registered_scenarios():
+    """Names of the registered scenarios, in registration order."""
+    return tuple(_SCENARIOS)
+
+
+#: Packages that register scenarios and estimators when imported; loaded (once) on the first unknown name,
+#: as a plugin host loads its plugins — the campaign layer never imports them statically (they sit above it).
+PROVIDERS = ("hinfnav.papers",)
+
+
+def load_providers():
+    """Import :data:`PROVIDERS` (registering their scenarios and estimators); return the modules that failed."""
+    failed = {}
+    for module in PROVIDERS:
+        try:
+            importlib.import_module(module)
+        except ImportError as exc:  # pragma: no cover - a provider under construction
+            failed[module] = str(exc)
+    return failed
+
+
+def scenario_entry(name, field="scenario"):
+    """The registry entry of ``name``; an :class:`InputError` naming ``field`` and the known names otherwise."""
+    if name not in _SCENARIOS:
+        load_providers()
+    if name not in _SCENARIOS:
+        known = ", ".join(_SCENARIOS) or "none (import the paper that registers it, e.g. hinfnav.papers)"
+        raise InputError(f"{field}: unknown scenario {name!r}; registered: {known}")
+    return _SCENARIOS[name]
+
+
+def _keyword_names(func):
+    try:
+        params = inspect.signature(func).parameters.values()
+    except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
+        return ()
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return tuple(p.name for p in params if p.kind in kinds and p.name != "self")
+
+
+def scenario_parameters(name):
+    """Settings the scenario ``name`` accepts (the keyword parameters of its factory)."""
+    return _keyword_names(scenario_entry(name).factory)
+
+
+def condition_parameters(scenario):
+    """Conditions a scenario's ``truth_model`` accepts (``maneuver``, ``delta``, ``discretization`` for Sun 2011)."""
+    return _keyword_names(scenario.truth_model)
+
+
+def build_scenario(name, **settings):
+    """The scenario registered as ``name`` with ``settings`` (validated by the scenario itself)."""
+    return scenario_entry(name).factory(**settings)

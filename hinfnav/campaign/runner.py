@@ -1,0 +1,389 @@
+"""Run a campaign on Dask: cells as tasks, streaming statistics only, one JSON per finished cell, resumable.
+
+:func:`run_campaign` sends the campaign's cells to a Dask cluster — by default
+a :class:`distributed.LocalCluster` with one single-threaded worker process per
+core of this machine, or the cluster of a given :class:`distributed.Client` or
+scheduler address — and collects each cell's statistics as it finishes. With
+``share_truth`` (the default) one task simulates a grid point's truth batch by
+batch and runs every estimator of that point on it; otherwise one task runs
+one cell. A task keeps streaming statistics only (:mod:`.stats`), so its
+memory is that of one batch of runs, whatever ``runs``.
+
+Finished cells are written to ``out_dir/cells/<cell_id>.json`` by the client
+as they arrive (written to a temporary name, then renamed: a cell file is
+whole or absent), so an interrupted campaign, run again into the same folder,
+computes only the cells that are missing. ``out_dir/campaign.json`` holds the
+spec and ``out_dir/results.csv`` the tidy table.
+
+The numbers do not depend on the number of workers, the order of completion
+or a resume: each cell's seed comes from the spec (:mod:`.spec`), each run
+draws from its own child generator, and the batches are those of the spec's
+``batch_size`` (tested bitwise against a serial run).
+"""
+
+import contextlib
+import importlib
+import json
+import logging
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..core.exceptions import InputError
+from ..core.outputs import MARKER, check_output_dir, to_json
+from ..core.progress import bar_disabled
+from ..core.provenance import package_version
+from ..estimators.registry import build_estimator, estimator_entry
+from ..sim.montecarlo import check_measurement_match
+from ..sim.truth import simulate_truth
+from .registry import build_scenario, scenario_entry
+from .spec import canonical, load_campaign
+from .stats import CellAccumulator
+from .table import results_table
+
+__all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "SERIAL"]
+
+#: ``client=SERIAL`` runs every task in this process, one after another (no cluster; for debugging and tests).
+SERIAL = "serial"
+
+_BUILT = {}  # per process: (scenario, settings, estimator, options) -> Estimator (designs are solved once)
+_MAX_BUILT = 64
+
+
+def clear_cache():
+    """Forget the estimators this process has built (designs are solved again on next use)."""
+    _BUILT.clear()
+
+
+def _key(*parts):
+    return json.dumps(canonical(list(parts)), sort_keys=True)
+
+
+def _scenario(name, settings):
+    key = _key("scenario", name, settings)
+    if key not in _BUILT:
+        _BUILT[key] = build_scenario(name, **settings)
+    return _BUILT[key]
+
+
+def _estimator(scenario, name, settings, est, options):
+    key = _key("estimator", name, settings, est, options)
+    if key not in _BUILT:
+        if len(_BUILT) >= _MAX_BUILT:
+            _BUILT.clear()
+        _BUILT[key] = build_estimator(est, scenario, **options)
+    return _BUILT[key]
+
+
+def campaign_units(campaign, pending=None):
+    """The tasks of a campaign: dicts holding one truth and the cells (estimators) to run on it.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    pending : set of str, optional
+        Cell ids still to compute (default: all).
+    """
+    units = {}
+    for cell in campaign.cells():
+        if pending is not None and cell.cell_id not in pending:
+            continue
+        key = cell.truth_key if campaign.share_truth else cell.cell_id
+        if key not in units:
+            modules = {scenario_entry(cell.scenario).factory.__module__}
+            units[key] = {"scenario": cell.scenario, "settings": cell.settings, "conditions": cell.conditions,
+                          "noise": cell.noise, "seed": cell.seed, "runs": campaign.runs,
+                          "batch_size": campaign.batch_size, "windows": campaign.windows, "tol": campaign.tol,
+                          "cells": [], "modules": modules}
+        units[key]["cells"].append({"cell_id": cell.cell_id, "estimator": cell.estimator, "options": cell.options,
+                                    "params": cell.params})
+        units[key]["modules"].add(estimator_entry(cell.estimator).builder.__module__)
+    out = list(units.values())
+    for unit in out:
+        unit["modules"] = sorted(unit["modules"])
+    return out
+
+
+def run_unit(unit):
+    """Run one task (see :func:`campaign_units`); return one result dict per cell.
+
+    Executed on a worker: imports the modules that register the scenario and
+    the estimators, simulates the truth batch by batch and runs every
+    estimator of the unit on each batch. An estimator that fails is reported
+    with ``status="error"`` (and is not written: a resume tries it again); one
+    whose estimates are not finite gets ``status="diverged"``.
+    """
+    for module in unit["modules"]:
+        importlib.import_module(module)
+    t_start, c_start = time.perf_counter(), time.process_time()
+    scenario = _scenario(unit["scenario"], unit["settings"])
+    model = scenario.truth_model(**unit["conditions"])
+    runs, bs = unit["runs"], unit["batch_size"]
+    cells = unit["cells"]
+    estimators, accs, errors = {}, {}, {}
+    elapsed, cpu = dict.fromkeys((c["cell_id"] for c in cells), 0.0), dict.fromkeys((c["cell_id"] for c in cells), 0.0)
+    for c in cells:
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            estimators[c["cell_id"]] = _estimator(scenario, unit["scenario"], unit["settings"], c["estimator"],
+                                                  c["options"])
+            accs[c["cell_id"]] = CellAccumulator(unit["windows"], runs, unit["tol"])
+        except Exception as exc:  # noqa: BLE001 - reported per cell, the campaign goes on
+            errors[c["cell_id"]] = f"{type(exc).__name__}: {exc}"
+        elapsed[c["cell_id"]] += time.perf_counter() - t0
+        cpu[c["cell_id"]] += time.process_time() - c0
+    truth_s = truth_cpu = 0.0
+    for start in range(0, runs, bs):
+        n = min(bs, runs - start)
+        t0, c0 = time.perf_counter(), time.process_time()
+        truth = simulate_truth(model, noise=unit["noise"], runs=n, seed=unit["seed"], first_run=start)
+        truth_s += time.perf_counter() - t0
+        truth_cpu += time.process_time() - c0
+        for c in cells:
+            cid = c["cell_id"]
+            if cid in errors:
+                continue
+            t0, c0 = time.perf_counter(), time.process_time()
+            try:
+                est = estimators[cid]
+                check_measurement_match(est, truth.measurement)
+                hist = est.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False)
+                err = truth.x - hist.xhat if truth.state is None else truth.state.error(truth.x, hist.xhat)
+                with np.errstate(all="ignore"):
+                    accs[cid].add(start, truth.t, err, truth.state)
+                del hist, err
+            except Exception as exc:  # noqa: BLE001
+                errors[cid] = f"{type(exc).__name__}: {exc}"
+            elapsed[cid] += time.perf_counter() - t0
+            cpu[cid] += time.process_time() - c0
+        del truth
+    out = []
+    for c in cells:
+        cid = c["cell_id"]
+        res = {"cell_id": cid, "params": c["params"], "options": c["options"], "seed": unit["seed"], "runs": runs,
+               "batch_size": bs, "hinfnav": package_version(),
+               "timing": {"estimator_s": elapsed[cid], "estimator_cpu_s": cpu[cid], "truth_s": truth_s,
+                          "truth_cpu_s": truth_cpu, "unit_s": time.perf_counter() - t_start,
+                          "unit_cpu_s": time.process_time() - c_start, "unit_cells": len(cells)}}
+        if cid in errors:
+            res.update(status="error", error=errors[cid])
+        else:
+            stats = accs[cid].result()
+            res.update(status="diverged" if stats["nonfinite_runs"] else "ok", statistics=stats)
+        out.append(res)
+    return out
+
+
+def _clean(obj):
+    """JSON-ready, with NaN and inf as null (strict JSON)."""
+    obj = to_json(obj)
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def _atomic_write(path, text):
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _read_cell(path, cell_id):
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("cell_id") != cell_id or data.get("status") not in ("ok", "diverged"):
+        return None
+    return data
+
+
+def _open_client(client, workers, connect_timeout):
+    """``(client, owned)``: the client to use and whether this call made it (and must close it)."""
+    from distributed import Client, LocalCluster  # heavy optional library: imported when a campaign runs
+
+    if client is None:
+        n = workers if workers is not None else (os.cpu_count() or 1)
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
+        return Client(cluster), True
+    if isinstance(client, str):
+        try:
+            return Client(client, timeout=connect_timeout), True
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"scheduler: cannot connect to {client!r} within {connect_timeout:g} s ({exc})") from None
+    if isinstance(client, Client):
+        return client, False
+    raise InputError(f"client must be None, {SERIAL!r}, a scheduler address or a distributed.Client; "
+                     f"got {type(client).__name__}")
+
+
+@contextlib.contextmanager
+def campaign_client(client=None, *, workers=None, connect_timeout=5.0):
+    """Context manager: the Dask client for several campaigns (a LocalCluster started once, closed at the end).
+
+    ``client`` as in :func:`run_campaign`; ``"serial"`` is passed through. Yields what to pass as ``client``.
+    """
+    if client == SERIAL:
+        yield SERIAL
+        return
+    dask_client, owned = _open_client(client, workers, connect_timeout)
+    try:
+        yield dask_client
+    finally:
+        if owned:
+            _close(dask_client)
+
+
+def _close(dask_client):
+    cluster = dask_client.cluster
+    dask_client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def _prepare_out(out_dir, campaign):
+    out = check_output_dir(out_dir, "out_dir")
+    (out / "cells").mkdir(parents=True, exist_ok=True)
+    if not (out / MARKER).exists():
+        (out / MARKER).write_text("written by hinfnav: a campaign folder; finished cells are kept and reused\n")
+    _atomic_write(out / "campaign.json", json.dumps(_clean({"spec": campaign.as_dict(),
+                                                             "cells": [c.cell_id for c in campaign.cells()]}),
+                                                    indent=2) + "\n")
+    return out
+
+
+def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None, connect_timeout=5.0):
+    """Run a campaign on Dask and return its tidy results table.
+
+    Parameters
+    ----------
+    spec : Campaign, dict or path of a TOML file
+        See :mod:`hinfnav.campaign.spec`.
+    client : None, "serial", str or distributed.Client
+        None: a new :class:`distributed.LocalCluster` (``workers`` processes,
+        default one per core), closed at the end. A string: the address of a
+        running scheduler (``tcp://host:8786``). A Client: its cluster.
+        ``"serial"``: every task in this process, one after another.
+    out_dir : str or Path, optional
+        Folder of the campaign: cells already there are reused, new ones are
+        written as they finish, ``results.csv`` at the end. None: nothing is
+        written (and nothing can be resumed).
+    progress : bool
+        Show a progress bar over the cells (and the runs they hold).
+    workers : int, optional
+        Worker processes of the LocalCluster (only with ``client=None``).
+    connect_timeout : float
+        Seconds to wait for a scheduler address before giving up.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, window, quantity (state component or group) and
+        statistic (:func:`hinfnav.campaign.table.results_table`);
+        ``attrs`` holds ``campaign`` (the spec), ``computed`` and ``reused``
+        (cell counts), ``errors`` (cell id → message) and ``cells`` (the cell
+        results, in grid order).
+    """
+    campaign = load_campaign(spec)
+    cells = campaign.cells()  # validates every name and value before any work
+    if workers is not None:
+        if client is not None:
+            raise InputError(f"workers applies to the LocalCluster that run_campaign starts (client=None) only; "
+                             f"got client={client!r}")
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+            raise InputError(f"workers must be an integer >= 1; got {workers!r}")
+    if not (isinstance(connect_timeout, (int, float)) and connect_timeout > 0):
+        raise InputError(f"connect_timeout must be a number of seconds > 0; got {connect_timeout!r}")
+    out = _prepare_out(out_dir, campaign) if out_dir is not None else None
+    results = {}
+    if out is not None:
+        for cell in cells:
+            found = _read_cell(out / "cells" / f"{cell.cell_id}.json", cell.cell_id)
+            if found is not None:
+                results[cell.cell_id] = found
+    reused = len(results)
+    units = campaign_units(campaign, pending={c.cell_id for c in cells} - set(results))
+    units.sort(key=lambda u: -len(u["cells"]) * u["runs"])  # largest first: a shorter tail
+    errors, computed = {}, 0
+    bar = tqdm(total=len(cells), initial=reused, disable=bar_disabled(progress), desc=campaign.name, unit="cell")
+
+    def collect(unit_results):
+        nonlocal computed
+        for res in unit_results:
+            if res["status"] == "error":
+                errors[res["cell_id"]] = res["error"]
+            else:
+                computed += 1
+                results[res["cell_id"]] = res
+                if out is not None:
+                    _atomic_write(out / "cells" / f"{res['cell_id']}.json", json.dumps(_clean(res), indent=1) + "\n")
+        bar.update(len(unit_results))
+        bar.set_postfix(runs=f"{(len(results) + len(errors)) * campaign.runs}/{len(cells) * campaign.runs}")
+
+    try:
+        if units and client == SERIAL:
+            for unit in units:
+                collect(run_unit(unit))
+        elif units:
+            _run_distributed(units, client, workers, connect_timeout, collect)
+    finally:
+        bar.close()
+    ordered = [results[c.cell_id] for c in cells if c.cell_id in results]
+    table = results_table(ordered)
+    if out is not None:
+        tmp = out / f".results.csv.{os.getpid()}.tmp"
+        table.to_csv(tmp, index=False)
+        os.replace(tmp, out / "results.csv")
+    table.attrs.update(campaign=campaign.as_dict(), computed=computed, reused=reused, errors=errors,
+                       cells=ordered, out_dir=None if out is None else str(out))
+    return table
+
+
+def _run_distributed(units, client, workers, connect_timeout, collect):
+    from distributed import as_completed  # heavy optional library: imported when a campaign runs
+
+    dask_client, owned = _open_client(client, workers, connect_timeout)
+    futures = []
+    try:
+        for i, unit in enumerate(units):
+            futures.append(dask_client.submit(run_unit, unit, pure=False, priority=len(units) - i,
+                                              key=f"campaign-unit-{unit['cells'][0]['cell_id']}"))
+        for fut in as_completed(futures):
+            collect(fut.result())
+    finally:
+        for fut in futures:
+            fut.cancel()
+        if owned:
+            _close(dask_client)
+
+
+def read_campaign(out_dir):
+    """The tidy table of the cells a campaign folder holds (finished cells only), without running anything.
+
+    Returns
+    -------
+    pandas.DataFrame
+        As :func:`run_campaign` returns, ``attrs`` with ``campaign``, ``cells``, ``missing`` (cell ids not yet there).
+    """
+    out = Path(out_dir).expanduser()
+    try:
+        meta = json.loads((out / "campaign.json").read_text())
+    except (OSError, ValueError):
+        raise InputError(f"out_dir: {out} holds no campaign (no readable campaign.json)") from None
+    cells, missing = [], []
+    for cid in meta["cells"]:
+        found = _read_cell(out / "cells" / f"{cid}.json", cid)
+        (cells.append(found) if found is not None else missing.append(cid))
+    table = results_table(cells)
+    table.attrs.update(campaign=meta["spec"], cells=cells, missing=missing, out_dir=str(out))
+    return table
+

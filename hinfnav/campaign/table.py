@@ -1,0 +1,67 @@
+"""The tidy results table of a campaign: one row per cell, window, quantity and statistic.
+
+Columns: ``cell_id``, the cell's parameters (``scenario``, ``estimator``,
+``noise``, then its conditions and settings), ``runs``, ``seed``, ``status``,
+``window``, ``window_start_s``, ``window_end_s``, ``quantity`` (a state
+component such as ``x``, or a group such as ``position``), ``kind``
+(``component``, ``group`` or ``run``), ``unit``, ``statistic`` and ``value``.
+
+Statistics per window and quantity: ``rms_pooled`` (over all runs and
+samples) with ``rms_ci95_low`` / ``rms_ci95_high`` (its 95 % interval,
+:func:`hinfnav.campaign.stats.rms_interval`), ``mc_mean`` (mean over runs of each run's RMS) with ``ci95_low`` /
+``ci95_high`` (its 95 % confidence interval), ``spread95_low`` /
+``spread95_high`` (2.5 and 97.5 % of the runs' RMS: what one run may give),
+``max_abs``. Per cell (window ``""``, quantity ``"all"``):
+``convergence_median_s`` and ``convergence_fraction`` when the campaign has
+tolerances, ``nonfinite_runs``. A group's RMS is the root mean square of its
+components' RMS (Table 1 of Sun 2011 reports position and velocity so).
+"""
+
+import pandas as pd
+
+__all__ = ["results_table", "STATISTICS", "COLUMNS"]
+
+#: Statistics per window and quantity, with the key of the cell JSON they come from.
+STATISTICS = (("rms_pooled", "pooled"), ("rms_ci95_low", "rms_ci95_low"), ("rms_ci95_high", "rms_ci95_high"),
+              ("mc_mean", "mean"), ("ci95_low", "ci95_low"), ("ci95_high", "ci95_high"),
+              ("spread95_low", "spread95_low"), ("spread95_high", "spread95_high"), ("max_abs", "max_abs"))
+#: Columns that follow the parameter columns.
+COLUMNS = ("runs", "seed", "status", "window", "window_start_s", "window_end_s", "quantity", "kind", "unit",
+           "statistic", "value")
+
+
+def _num(v):
+    return float("nan") if v is None else float(v)
+
+
+def _rows(cell):
+    base = {"cell_id": cell["cell_id"], **cell["params"], "runs": cell["runs"], "seed": cell["seed"],
+            "status": cell["status"]}
+    st = cell["statistics"]
+    for wname, w in st["windows"].items():
+        wb = dict(base, window=wname, window_start_s=float(w["window"][0]), window_end_s=float(w["window"][1]))
+        for i, (label, unit) in enumerate(zip(st["labels"], st["units"])):
+            for stat, key in STATISTICS:
+                yield dict(wb, quantity=label, kind="component", unit=unit, statistic=stat, value=_num(w[key][i]))
+        for g, gs in w["groups"].items():
+            unit = st["groups"][g]["unit"]
+            for stat, key in STATISTICS:
+                yield dict(wb, quantity=g, kind="group", unit=unit, statistic=stat, value=_num(gs[key]))
+    rb = dict(base, window="", window_start_s=float("nan"), window_end_s=float("nan"), quantity="all", kind="run")
+    conv = st.get("convergence")
+    if conv is not None:
+        yield dict(rb, unit="s", statistic="convergence_median_s", value=_num(conv["median_s"]))
+        yield dict(rb, unit="", statistic="convergence_fraction", value=_num(conv["fraction"]))
+    yield dict(rb, unit="", statistic="nonfinite_runs", value=float(st["nonfinite_runs"]))
+
+
+def results_table(cells):
+    """The tidy :class:`pandas.DataFrame` of a list of cell results (see the module docstring)."""
+    params = []
+    for cell in cells:
+        for key in cell["params"]:
+            if key not in params:
+                params.append(key)
+    columns = ["cell_id"] + params + list(COLUMNS)
+    rows = [r for cell in cells for r in _rows(cell)]
+    return pd.DataFrame(rows, columns=columns)

@@ -1,0 +1,257 @@
+"""The two ideas of paper 002 as small hooks on one EKF: strong tracking and rate-adapted noise.
+
+Both act on an :class:`~hinfnav.estimators.augmented.AugmentedEKF` (an EKF
+whose last error coordinates are random-walk augmented states) by overriding
+one hook each.
+
+**Strong tracking** (suboptimal multiple fading factors; Zhou, Xi & Zhang,
+Acta Automatica Sinica 17(6), 1991, rebuilt there from; paper 002 §2.3):
+with the innovation γ(k+1) = y(k+1) − h(x̂(k+1|k)),
+
+* ``V₀(1) = γ₁γ₁ᵀ``, ``V₀(k+1) = (ρ V₀(k) + γγᵀ)/(1 + ρ)``  (S1)
+* ``N = V₀ − β R − H Q_d Hᵀ``,  ``M = Φ P Φᵀ Hᵀ H``           (S2)
+* ``c = tr N / Σᵢ aᵢ Mᵢᵢ``,  ``λᵢ = max(1, aᵢ c)``             (S3)
+* ``P(k+1|k) = Λ^{1/2} Φ P Φᵀ Λ^{1/2} + Q_d``                 (S4)
+
+ρ ∈ (0, 1] is the forgetting factor, β ≥ 1 the weakening factor and aᵢ ≥ 1
+the prior weights. Paper 002 prints ``Λ Φ P Φᵀ``, which is not symmetric;
+(S4) is the symmetric reading: it has the same diagonal (λᵢ (ΦPΦᵀ)ᵢᵢ), scales
+the off-diagonal terms by √(λᵢλⱼ) and is identical to ΛΦPΦᵀ when all λ are
+equal (documented choice). Since λ(k+1) needs γ(k+1), the covariance
+prediction is completed when y(k+1) arrives (the mean prediction does not
+depend on λ). With every λ = 1 the filter is the plain EKF, exactly.
+
+**Rate-adapted noise** (paper 002 §2.2, AAEKF):
+``Q(t_k) = Q(t₀) F[ε κ(t_k)]``, ``κ(t_k) = (β̂_k − β̂_{k−m}) / (m Δt)``
+(the augmented states' rate over the last m steps) (R1). The printed
+``F[x] = x xᵀ`` is rank one (it would give no noise at all to every direction
+orthogonal to κ, and none at all where κ = 0); the reading used here is
+element-wise with a floor, ``Q_ii(t_k) = Q_ii(t₀) max(f_min, (ε κᵢ)²)`` (R2):
+each channel's noise grows with the square of its own rate once
+|ε κᵢ| > √f_min, and never falls below f_min Q(t₀) (documented choice). ε
+carries the unit s per unit of the augmented state. Before m steps have
+passed κ uses the steps available.
+"""
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.validation import as_int_at_least, as_nonnegative, as_positive
+
+__all__ = [
+    "RateAdaptive",
+    "StrongTracking",
+    "fade",
+    "fading_factors",
+    "innovation_moment",
+    "input_rate",
+    "per_run_parameter",
+    "rate_adapted_density",
+]
+
+
+def per_run_parameter(name, value, check):
+    """A scalar parameter, or one value per run (a parameter sweep batched as runs), validated by ``check``.
+
+    Returns a float or a read-only 1-D array.
+    """
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        return check(name, float(arr))
+    if arr.ndim != 1 or arr.size == 0:
+        raise InputError(f"{name} must be a number or a 1-D array with one value per run; got shape {arr.shape}")
+    out = np.array([check(f"{name}[{i}]", float(v)) for i, v in enumerate(arr)])
+    out.setflags(write=False)
+    return out
+
+
+def _column(p, ndim):
+    """Broadcast a per-run parameter against arrays whose leading axis is the run."""
+    p = np.asarray(p)
+    return p if p.ndim == 0 else p.reshape(p.shape + (1,) * (ndim - 1))
+
+
+def innovation_moment(V0, innovation, rho):
+    """The innovation second moment (S1), batched: shape (runs, m, m).
+
+    ``V0`` None starts the recursion with γγᵀ.
+    """
+    gg = innovation[..., :, None] * innovation[..., None, :]
+    if V0 is None:
+        return gg
+    rho = _column(rho, 3)
+    return (rho * V0 + gg) / (1.0 + rho)
+
+
+def fading_factors(V0, H, PhiPPhiT, Qd, R, *, beta, a):
+    """Multiple fading factors λ of (S2)–(S3), shape (runs, n), and c, shape (runs,).
+
+    Parameters
+    ----------
+    V0 : ndarray, shape (runs, m, m)
+    H : ndarray, shape (m, n) or (runs, m, n)
+    PhiPPhiT : ndarray, shape (n, n) or (runs, n, n)
+    Qd : ndarray, shape (n, n) or (runs, n, n)
+        Process noise per step, Δt Γ Q Γᵀ.
+    R : ndarray, shape (m, m)
+    beta : float
+    a : ndarray, shape (n,)
+    """
+    HT = np.swapaxes(H, -1, -2)
+    N = V0 - _column(beta, 3) * R - H @ Qd @ HT
+    trN = np.trace(N, axis1=-2, axis2=-1)
+    Mdiag = np.sum((PhiPPhiT @ HT) * HT, axis=-1)  # diag(Φ P Φᵀ Hᵀ H)
+    den = np.sum(a * Mdiag, axis=-1)
+    c = trN / np.where(den > 0, den, np.inf)
+    lam = np.maximum(1.0, a * np.atleast_1d(c)[..., None])
+    return lam, c
+
+
+def fade(PhiPPhiT, lam):
+    """``Λ^{1/2} Φ P Φᵀ Λ^{1/2}`` (S4, symmetric reading), batched."""
+    s = np.sqrt(lam)
+    return s[..., :, None] * PhiPPhiT * s[..., None, :]
+
+
+def input_rate(window, count, m, dt):
+    """Rate of the augmented states (R1) from a ring buffer of estimates.
+
+    Parameters
+    ----------
+    window : ndarray, shape (m + 1, runs, n_aug)
+        The last estimates, slot ``j % (m + 1)`` holding step j.
+    count : int
+        Number of estimates pushed so far (the newest is step count − 1).
+    m : int
+    dt : float
+
+    Returns
+    -------
+    ndarray, shape (runs, n_aug)
+        ``(β̂_newest − β̂_oldest) / (span Δt)``, span = min(m, count − 1); zero
+        before two estimates exist.
+    """
+    if count < 2:
+        return np.zeros(window.shape[1:])
+    span = min(m, count - 1)
+    newest = window[(count - 1) % (m + 1)]
+    oldest = window[(count - 1 - span) % (m + 1)]
+    return (newest - oldest) / (span * dt)
+
+
+def rate_adapted_density(Q0_diag, kappa, epsilon, floor):
+    """``Q_ii = Q0_ii max(floor, (ε κᵢ)²)`` of (R2), shape (runs, n_aug)."""
+    return Q0_diag * np.maximum(floor, (_column(epsilon, 2) * kappa) ** 2)
+
+
+def _check_rho(name, value):
+    value = as_positive(name, value)
+    if value > 1:
+        raise InputError(f"{name} (forgetting factor) must be in (0, 1]; got {value}")
+    return value
+
+
+def _check_beta(name, value):
+    value = as_positive(name, value)
+    if value < 1:
+        raise InputError(f"{name} (weakening factor) must be >= 1; got {value}")
+    return value
+
+
+class StrongTracking:
+    """Mixin: strong tracking by multiple fading factors (S1)–(S4).
+
+    Put it before an :class:`~hinfnav.estimators.augmented.AugmentedEKF`
+    subclass in the bases. Keyword parameters (besides the host's):
+
+    Parameters
+    ----------
+    rho : float or array_like, shape (runs,)
+        Forgetting factor of (S1), 0 < ρ ≤ 1 (0.95).
+    beta : float or array_like, shape (runs,)
+        Weakening factor of (S2), β ≥ 1 (1.0). ρ and β may hold one value
+        per run (a parameter sweep batched as runs).
+    a : array_like, shape (n_cov,), optional
+        Prior weights aᵢ ≥ 1 of (S3), one per error coordinate (all 1: no
+        coordinate is singled out, i.e. one common fading factor).
+
+    Diagnostics: ``fading`` (runs, n_cov) — the λᵢ of this step (1 at the
+    first measurement, processed with P₀) — and ``fading_c`` (runs,).
+    """
+
+    data_dependent_covariance = True
+
+    def __init__(self, *args, rho=0.95, beta=1.0, a=None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.rho = per_run_parameter("rho", rho, _check_rho)
+        self.beta = per_run_parameter("beta", beta, _check_beta)
+        a = np.ones(self.n_cov) if a is None else np.asarray(a, dtype=float)
+        if a.shape != (self.n_cov,) or not np.all(np.isfinite(a)) or np.any(a < 1):
+            raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
+        self.a = a
+
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
+        V0 = innovation_moment(state.extra.get("V0"), innovation, self.rho)
+        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, self.R, beta=self.beta, a=self.a)
+        P = fade(PhiPPhiT, lam) + Qd
+        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, {"V0": V0}
+
+    def initial_diagnostics(self, runs):
+        out = super().initial_diagnostics(runs)
+        out.update(fading=np.ones((runs, self.n_cov)), fading_c=np.full(runs, np.nan))
+        return out
+
+
+class RateAdaptive:
+    """Mixin: process noise of the augmented states from their estimated rate (R1)–(R2).
+
+    Parameters
+    ----------
+    window : int
+        m, the number of steps over which the rate is estimated (≥ 1).
+    epsilon : float or array_like, shape (runs,)
+        Compression factor ε, s per unit of the augmented state (> 0); one
+        value per run batches an ε sweep.
+    floor : float
+        f_min of (R2), ≥ 0 (1: Q(t₀) is the least noise).
+
+    The host's ``Q`` is Q(t₀). Diagnostics: ``q_adapted`` (runs, n_aug), the
+    density used for the prior of this step, and ``input_rate`` κ (runs, n_aug).
+    """
+
+    data_dependent_covariance = True
+
+    def __init__(self, *args, window=60, epsilon=1.0, floor=1.0, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.window = as_int_at_least("window", window, 1)
+        self.epsilon = per_run_parameter("epsilon", epsilon, as_positive)
+        self.floor = as_nonnegative("floor", floor)
+        self._Q0_diag = np.diag(self.Q).copy()
+
+    def process_noise(self, state):
+        extra = state.extra
+        kappa = input_rate(extra["rate_window"], extra["rate_count"], self.window, self.dt)
+        q = rate_adapted_density(self._Q0_diag, kappa, self.epsilon, self.floor)
+        Qd = self.base_noise + self.dt * np.einsum("ia,ra,ja->rij", self.E, q, self.E)
+        return Qd, {"q_used": q, "kappa_used": kappa}
+
+    def start(self, xhat0, P0=None, runs=1):
+        state = super().start(xhat0, P0, runs)
+        window = np.zeros((self.window + 1, runs, self.n_aug))
+        state.extra.update(rate_window=window, rate_count=0)
+        return state
+
+    def after_update(self, state, x_post):
+        window = state.extra["rate_window"].copy()
+        count = state.extra["rate_count"]
+        window[count % (self.window + 1)] = self.augmented(x_post)
+        return {"rate_window": window, "rate_count": count + 1}
+
+    def step_diagnostics(self, state):
+        out = super().step_diagnostics(state)
+        runs = state.x.shape[0]
+        q = state.extra.get("q_used")
+        kappa = state.extra.get("kappa_used")
+        out["q_adapted"] = np.broadcast_to(self._Q0_diag, (runs, self.n_aug)) if q is None else q
+        out["input_rate"] = np.zeros((runs, self.n_aug)) if kappa is None else kappa
+        return out

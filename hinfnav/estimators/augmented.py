@@ -1,0 +1,390 @@
+"""One EKF with augmented random-walk states, and its use on a linear system with unknown inputs.
+
+:class:`AugmentedEKF` is the EKF shared by paper 002's three filters (AEKF,
+ASTEKF, AAEKF) and by their transfer to the chaser. It works in *error
+coordinates* (dimension ``n_cov``, the covariance's), whose last ``n_aug``
+coordinates are augmented states β with ``β̇ = n_β``, E[n_β n_βᵀ] = Q δ(t−τ):
+
+* prediction  ``x̂(k+1|k) = f(x̂(k|k), u_k)``,
+  ``P(k+1|k) = Φ P Φᵀ + Q_d``, ``Q_d = Q_base + Δt Γ Q Γᵀ``   (E1)
+  (paper 002: Φ = e^{FΔt}, P⁻ = ΦPΦᵀ + ΔtΓQΓᵀ);
+* update (Joseph form) ``K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹``, ``δx = K γ``,
+  ``P = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ``, x̂ ← inject(x̂⁻, δx)   (E2).
+
+A subclass supplies the model (hooks ``initial_internal``, ``propagate_mean``,
+``transition``, ``observe``, ``inject``, ``report``, ``report_covariance``,
+``augmented``); the ideas of :mod:`hinfnav.estimators.adaptive` override
+``predict_covariance`` (strong tracking) or ``process_noise`` (adaptive).
+
+:class:`AugmentedInputKF` wraps a :class:`~hinfnav.systems.LinearSystem`
+``x(k+1) = Φ x + Γ u + B w`` whose input u is *unknown* to the filter and is
+estimated as random-walk states: ``[x; u](k+1) = [[Φ, Γ], [0, I]] [x; u]``.
+It reports the system's state (so it fits the system's scenarios and the
+contract suite); the input estimate is in the diagnostics
+(``input_estimate``). With a linear measurement and no data-dependent idea,
+its covariance is shared by every run.
+"""
+
+import numpy as np
+
+from ..core.exceptions import HinfnavError, InputError
+from ..core.linalg import as_covariance
+from ..core.validation import as_choice
+from .adaptive import RateAdaptive, StrongTracking
+from .base import (
+    EstimateHistory,
+    Estimator,
+    FilterState,
+    StepOutput,
+    check_estimator_inputs,
+)
+from .kalman import OUTPUTS
+
+__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF", "joseph_update"]
+
+#: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
+_TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
+
+
+def joseph_update(P, H, R, innovation):
+    """Kalman correction (E2), batched; returns ``(δx, P⁺)``.
+
+    ``P`` is (n, n) shared with ``H`` (m, n), or per run (runs, n, n) with
+    ``H`` (m, n) or (runs, m, n).
+    """
+    HT = np.swapaxes(H, -1, -2)
+    PHT = P @ HT
+    S = H @ PHT + R
+    K = np.swapaxes(np.linalg.solve(S, np.swapaxes(PHT, -1, -2)), -1, -2)
+    if K.ndim == 2:
+        dx = innovation @ K.T
+    else:
+        dx = np.einsum("rij,rj->ri", K, innovation)
+    I_KH = np.eye(P.shape[-1]) - K @ H
+    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
+    return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
+
+
+class AugmentedEKF(Estimator):
+    """EKF in error coordinates with augmented random-walk states (E1)–(E2); see the module docstring.
+
+    Parameters
+    ----------
+    system, measurement
+        The model (the subclass reads what it needs).
+    n_cov : int
+        Dimension of the error coordinates (and of P).
+    aug_input : ndarray, shape (n_cov, n_aug)
+        Γ: how the augmented states' noise enters the error coordinates.
+    P0 : array_like, shape (n_cov, n_cov)
+        Default initial covariance (positive definite).
+    Q : array_like, shape (n_aug, n_aug) or (runs, n_aug, n_aug)
+        Noise density of the augmented states (unit²/s), applied as Δt Γ Q Γᵀ.
+        With a leading axis, one density per run (a parameter sweep batched
+        as runs): the filter then runs exactly that many runs.
+    base_noise : array_like, shape (n_cov, n_cov), optional
+        Per-step process noise of the other coordinates (zero).
+    R : array_like, optional
+        Measurement covariance (default the model's D Dᵀ).
+    uses_input : bool
+    output : {"filtered", "predicted"}
+    name : str
+    """
+
+    name = "augmented ekf"
+    data_dependent_covariance = False
+    linear_model = False
+
+    def __init__(self, system, measurement, *, n_cov, aug_input, P0, Q, base_noise=None, R=None, uses_input=False,
+                 output="filtered", name=None):
+        super().__init__(system, measurement, name=name)
+        self.n_cov = int(n_cov)
+        self.E = np.asarray(aug_input, dtype=float)
+        if self.E.ndim != 2 or self.E.shape[0] != self.n_cov:
+            raise InputError(f"aug_input must have shape ({self.n_cov}, n_aug); got {self.E.shape}")
+        self.n_aug = self.E.shape[1]
+        Q = np.asarray(Q, dtype=float)
+        if Q.ndim == 3:
+            self.Q = np.stack([as_covariance(f"Q[{i}]", Qi, self.n_aug, definite=False) for i, Qi in enumerate(Q)])
+            self.Q.setflags(write=False)
+        else:
+            self.Q = as_covariance("Q", Q, self.n_aug, definite=False)
+        self.base_noise = (np.zeros((self.n_cov, self.n_cov)) if base_noise is None
+                           else as_covariance("base_noise", base_noise, self.n_cov, definite=False))
+        self.R = as_covariance("R", measurement.R if R is None else R, measurement.n_meas, definite=True)
+        self.P0 = as_covariance("P0", P0, self.n_cov, definite=True)
+        if not isinstance(uses_input, (bool, np.bool_)):
+            raise InputError(f"uses_input must be True or False; got {uses_input!r}")
+        self.uses_input = bool(uses_input)
+        self.output = as_choice("output", output, OUTPUTS)
+        self.Qd = self.base_noise + self.dt * self.E @ self.Q @ self.E.T
+
+    @property
+    def parameter_runs(self):
+        """Number of runs a per-run parameter fixes (Q, or an idea's ρ, β, ε), or None."""
+        sizes = {self.Q.shape[0]} if self.Q.ndim == 3 else set()
+        for key in ("rho", "beta", "epsilon"):
+            val = getattr(self, key, None)
+            if isinstance(val, np.ndarray):
+                sizes.add(val.size)
+        if len(sizes) > 1:
+            raise InputError(f"per-run parameters must all have the same number of runs; got {sorted(sizes)}")
+        return sizes.pop() if sizes else None
+
+    @property
+    def shares_covariance(self):
+        """True when P and the gain do not depend on the data (linear model, no adaptive idea, one Q)."""
+        return self.linear_model and not self.data_dependent_covariance and self.parameter_runs is None
+
+    # -- model hooks (subclasses) ------------------------------------------------
+
+    def initial_internal(self, xhat0):
+        """Internal state from the reported prior estimate, shape (n_x,)."""
+        raise NotImplementedError
+
+    def propagate_mean(self, x, u):
+        """``f(x̂, u)`` for a batch, shape (runs, n_x)."""
+        raise NotImplementedError
+
+    def transition(self, x, u):
+        """Φ of the error coordinates at the posterior, (n_cov, n_cov) or (runs, n_cov, n_cov)."""
+        raise NotImplementedError
+
+    def observe(self, x):
+        """``(ŷ, H)`` at the prior: ŷ (runs, m), H (m, n_cov) or (runs, m, n_cov)."""
+        raise NotImplementedError
+
+    def inject(self, x, dx):
+        """The internal state corrected by ``dx`` (error coordinates)."""
+        raise NotImplementedError
+
+    def report(self, x):
+        """The estimate reported in the system's coordinates, (runs, system.n)."""
+        raise NotImplementedError
+
+    def report_covariance(self, P):
+        """The covariance reported with the estimate."""
+        return P
+
+    def augmented(self, x):
+        """The augmented states' estimate, (runs, n_aug)."""
+        raise NotImplementedError
+
+    # -- idea hooks (see hinfnav.estimators.adaptive) ---------------------------------
+
+    def process_noise(self, state):
+        """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
+        return self.Qd, {}
+
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
+        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1)."""
+        return PhiPPhiT + Qd, {}, {}
+
+    def after_update(self, state, x_post):
+        """Extra items to keep after an update (none here)."""
+        return {}
+
+    def initial_diagnostics(self, runs):
+        """Diagnostics every step reports, at their values before any prediction."""
+        return {}
+
+    def step_diagnostics(self, state):
+        """Diagnostics that depend on the prior ``state`` (the adapted noise …)."""
+        return {}
+
+    # -- the step contract ---------------------------------------------------------------
+
+    def start(self, xhat0, P0=None, runs=1):
+        if self.parameter_runs is not None and runs != self.parameter_runs:
+            raise InputError(f"runs must equal the number of per-run parameter values ({self.parameter_runs}); got {runs}")
+        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
+        x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
+        x = np.broadcast_to(x0, (runs, x0.size)).copy()
+        if not self.shares_covariance:
+            P = np.broadcast_to(P, (runs,) + P.shape).copy()
+        return FilterState(x=x, P=P)
+
+    def update(self, state, y):
+        x = state.x
+        y = np.asarray(y, dtype=float)
+        try:
+            yhat, H = self.observe(x)
+        except InputError as exc:
+            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
+        innovation = self.measurement.residual(y, yhat)
+        diag = self.initial_diagnostics(x.shape[0])
+        diag.update(self.step_diagnostics(state))
+        extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
+        if "PhiPPhiT" in state.extra:
+            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, innovation, H)
+            diag.update(d_hook)
+            extra.update(e_hook)
+        else:
+            P = state.P
+        try:
+            dx, P_post = joseph_update(P, H, self.R, innovation)
+        except np.linalg.LinAlgError:
+            dx = P_post = np.array(np.nan)
+        if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
+            raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
+        x_post = self.inject(x, dx)
+        extra.update(self.after_update(state, x_post))
+        diag.update(innovation=innovation, input_estimate=self.augmented(x_post))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
+        runs = x.shape[0]
+        if self.output == "filtered":
+            return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
+                                   diagnostics=diag)
+        return new, StepOutput(xhat=self.report(x), P=self._runs(self.report_covariance(P), runs), diagnostics=diag)
+
+    def predict(self, state, u=None):
+        if self.uses_input and u is None:
+            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+        u = None if u is None else np.asarray(u, dtype=float)
+        Qd, e_noise = self.process_noise(state)
+        Phi = self.transition(state.x, u)
+        x = self.propagate_mean(state.x, u)
+        PhiPPhiT = Phi @ state.P @ np.swapaxes(Phi, -1, -2)
+        extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
+        extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
+        return FilterState(x=x, P=PhiPPhiT + Qd, k=state.k + 1, extra=extra)
+
+    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
+        """As :meth:`Estimator.estimate` (same numbers), with two economies for long runs.
+
+        ``keep_covariance`` may be ``"diagonal"`` (keep the variances only,
+        shape (runs, n_samples, n)); ``diagnostics`` may name the diagnostics
+        to keep (an iterable of keys) instead of True (all) or False (none).
+        """
+        if keep_covariance not in (True, False, "diagonal"):
+            raise InputError(f"keep_covariance must be True, False or 'diagonal'; got {keep_covariance!r}")
+        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
+                                             self.n_input if self.uses_input else None)
+        keys = None if diagnostics is True else set(diagnostics or ())
+        runs, n1, _ = y.shape
+        state = self.start(xhat0, P0, runs)
+        xhat = np.empty((runs, n1, self.n_state))
+        P_hist, shared, diag = None, False, {}
+        for k in range(n1):
+            state, out = self.update(state, y[:, k])
+            xhat[:, k] = out.xhat
+            if keep_covariance:
+                P = np.diagonal(out.P, axis1=-2, axis2=-1) if keep_covariance == "diagonal" else out.P
+                if P_hist is None:
+                    shared = P.strides[0] == 0
+                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[1:])
+                if shared:
+                    P_hist[k] = P[0]
+                else:
+                    P_hist[:, k] = P
+            for key, val in out.diagnostics.items():
+                if keys is None or key in keys:
+                    if key not in diag:
+                        diag[key] = np.empty((runs, n1) + np.shape(val)[1:], dtype=np.asarray(val).dtype)
+                    diag[key][:, k] = val
+            if k < n1 - 1:
+                state = self.predict(state, u[:, k])
+        if shared:
+            P_hist.setflags(write=False)
+            P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
+        return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state, diagnostics=diag)
+
+    @staticmethod
+    def _runs(P, runs):
+        return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P
+
+
+class AugmentedInputKF(AugmentedEKF):
+    """Kalman filter of a linear system whose unknown input is estimated as random-walk states.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        Φ, Γ (the unknown input u enters through Γ), B (Q = B Bᵀ), dt, state.
+    measurement : MeasurementModel
+        On the system's n states (linear or not).
+    Q_input : array_like, shape (m_u, m_u)
+        Noise density of the input's random walk, (input unit)²/s; per step
+        Δt Q_input.
+    P0 : array_like, shape (n, n) or (n + m_u, n + m_u)
+        Initial covariance of the state (then ``P0_input`` completes it) or of
+        the augmented state.
+    P0_input : array_like, shape (m_u, m_u), optional
+        Initial covariance of the input estimate (required with an n × n P0).
+    Q : array_like, shape (n, n), optional
+        State process noise per step (default ``system.Q``).
+    R, output, name
+        As in :class:`AugmentedEKF`.
+
+    Notes
+    -----
+    The input u_k is held over [t_k, t_{k+1}) as in the truth, so the
+    augmented model ``x(k+1) = Φ x + Γ û`` is exact for a constant input; the
+    filter is not told the applied input (``uses_input`` is False).
+    """
+
+    name = "augmented input kf"
+
+    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None):
+        for attr in ("Phi", "Gamma"):
+            if not hasattr(system, attr):
+                raise InputError(f"system must be a hinfnav LinearSystem (with Phi, Gamma); got {type(system).__name__}")
+        n, m = system.n, system.n_input
+        if m < 1:
+            raise InputError("system has no input channel to estimate (Gamma has no columns)")
+        P0 = np.asarray(P0, dtype=float)
+        if P0.shape == (n, n):
+            if P0_input is None:
+                raise InputError(f"P0_input (initial covariance of the input estimate, {m}x{m}) is required with an {n}x{n} P0")
+            P0 = np.block([[P0, np.zeros((n, m))], [np.zeros((m, n)), np.asarray(P0_input, dtype=float)]])
+        base = np.zeros((n + m, n + m))
+        base[:n, :n] = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
+        E = np.vstack([np.zeros((n, m)), np.eye(m)])
+        super().__init__(system, measurement, n_cov=n + m, aug_input=E, P0=P0, Q=Q_input, base_noise=base, R=R,
+                         uses_input=False, output=output, name=name)
+        self.Phi_a = np.block([[system.Phi, system.Gamma], [np.zeros((m, n)), np.eye(m)]])
+        self._n = n
+        self.linear_model = bool(measurement.linear)
+        if self.linear_model:
+            self._H = np.hstack([measurement.H, np.zeros((measurement.n_meas, m))])
+
+    def initial_internal(self, xhat0):
+        return np.concatenate([xhat0, np.zeros(self.n_aug)])
+
+    def propagate_mean(self, x, u):
+        return x @ self.Phi_a.T
+
+    def transition(self, x, u):
+        return self.Phi_a
+
+    def observe(self, x):
+        xs = x[:, : self._n]
+        yhat = self.measurement.function(xs)
+        if self.linear_model:
+            return yhat, self._H
+        J = self.measurement.jacobian(xs)
+        return yhat, np.concatenate([J, np.zeros(J.shape[:-1] + (self.n_aug,))], axis=-1)
+
+    def inject(self, x, dx):
+        return x + dx
+
+    def report(self, x):
+        return x[:, : self._n]
+
+    def report_covariance(self, P):
+        return P[..., : self._n, : self._n]
+
+    def augmented(self, x):
+        return x[:, self._n:]
+
+
+class AugmentedInputSTKF(StrongTracking, AugmentedInputKF):
+    """:class:`AugmentedInputKF` with strong tracking (fading factors; ``rho``, ``beta``, ``a``)."""
+
+    name = "augmented input stkf"
+
+
+class AugmentedInputAdaptiveKF(RateAdaptive, AugmentedInputKF):
+    """:class:`AugmentedInputKF` whose input noise follows the input's estimated rate (``window``, ``epsilon``, ``floor``)."""
+
+    name = "augmented input adaptive kf"

@@ -1,0 +1,247 @@
+"""The recursive (game-theoretic) H∞ filter of Simon (2006), a-priori form, on the step contract.
+
+D. Simon, *Optimal State Estimation*, Wiley 2006, section 11.3: for
+``x(k+1) = F x(k) + Γ u(k) + w(k)``, ``y(k) = H x(k) + v(k)`` and the
+performance bound θ on the estimation error of ``z = L x`` weighted by S,
+
+.. code-block:: text
+
+    K_k     = P_k [I − θ S̄ P_k + HᵀR⁻¹H P_k]⁻¹ HᵀR⁻¹,          S̄ = Lᵀ S L
+    x̂_{k+1} = F x̂_k + F K_k (y_k − H x̂_k) + Γ u_k
+    P_{k+1} = F P_k [I − θ S̄ P_k + HᵀR⁻¹H P_k]⁻¹ Fᵀ + Q
+
+which exists only while ``P_k⁻¹ − θ S̄ + HᵀR⁻¹H > 0``. With θ = 0 it is the
+one-step Kalman predictor. The filter reports the a-priori estimate
+``x̂_k = x̂(k|k−1)`` at t_k (like the LTI filter (12), a predictor).
+
+Computation. With a factor ``P = C Cᵀ`` the push-through identity gives
+``P [I + G P]⁻¹ = C N⁻¹ Cᵀ``, ``G = HᵀR⁻¹H − θ S̄``, ``N = I + Cᵀ G C =
+Cᵀ(P⁻¹ + G)C``: the existence condition is ``N > 0`` (checked by a Cholesky
+factorization at every step; its smallest eigenvalue is reported as the
+``existence_margin`` diagnostic), ``K = C N⁻¹ Cᵀ HᵀR⁻¹`` and
+``P⁺ = F C N⁻¹ Cᵀ Fᵀ + Q``. P and K do not depend on the data: one recursion
+serves every run, and once ``‖P_{k+1} − P_k‖ ≤ 10⁻¹⁴ ‖P_k‖`` (Frobenius) the
+steady gain is kept (:func:`hinfnav.analysis.steady_state_hinf` gives that
+steady state directly).
+
+filterpy's ``HInfinityFilter`` (2.0) is not this filter: it propagates P only
+inside ``update`` (a ``predict`` without measurement leaves P where it was),
+its gain ``F P L HᵀV⁻¹`` already contains F, and ``update`` adds that
+correction to the *un-propagated* state, which ``predict`` then multiplies by
+F again: its estimate after update and predict is ``F x̂ + F² K (y − H x̂)``
+instead of ``F x̂ + F K (y − H x̂)``. With F = I the two coincide
+(``tests/test_recursive_hinf.py`` checks both statements).
+"""
+
+import numpy as np
+
+from ..analysis.hinf_riccati import max_admissible_theta
+from ..core.exceptions import HinfnavError, InputError
+from ..core.linalg import as_covariance
+from ..core.validation import as_choice, as_matrix, as_nonnegative
+from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+
+__all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
+
+#: What the filter does when the existence condition fails.
+ON_VIOLATION = ("raise", "flag")
+
+_FREEZE = 1e-14  # relative change of P below which the steady gain is kept
+
+
+class RecursiveHInfinityFilter(Estimator):
+    """Simon's a-priori recursive H∞ filter (see the module notes).
+
+    Parameters
+    ----------
+    system : LinearSystem
+        F = Φ, Γ (input), Q = B Bᵀ by default, dt, state labels.
+    measurement : MeasurementModel
+        Must be linear (``y = H x + D v``); R = D Dᵀ by default.
+    theta : float
+        Performance bound θ ≥ 0 (0: the Kalman predictor). Units: 1 / (units
+        of S-weighted z)².
+    P0 : array_like, shape (n, n)
+        Default initial P (positive definite); ``start`` may override it.
+    Q, R : array_like, optional
+        Process- and measurement-noise covariances (Q ≥ 0, R > 0).
+    L : array_like, shape (l, n), optional
+        The estimated combination z = L x (default I).
+    S : array_like, shape (l, l), optional
+        Weight of its error (symmetric ≥ 0, default I); S̄ = Lᵀ S L.
+    uses_input : bool
+        Propagate with the applied input ``Γ u`` (True, default) or ignore it.
+    on_violation : {"raise", "flag"}
+        When ``P_k⁻¹ − θS̄ + HᵀR⁻¹H > 0`` fails at a step: raise an
+        :class:`~hinfnav.core.exceptions.InputError` naming θ (default), or
+        set ``existence_ok`` False in the diagnostics and go on with the
+        same formulas (P may then lose definiteness).
+    name : str
+
+    Notes
+    -----
+    Diagnostics of ``update``: ``innovation`` (runs, m), ``existence_margin``
+    (runs,): smallest eigenvalue of ``N = Cᵀ(P⁻¹ − θS̄ + HᵀR⁻¹H)C``, and
+    ``existence_ok`` (runs,).
+    """
+
+    name = "recursive_hinf"
+
+    def __init__(self, system, measurement, *, theta, P0, Q=None, R=None, L=None, S=None, uses_input=True,
+                 on_violation="raise", name=None):
+        super().__init__(system, measurement, name=name)
+        if not getattr(measurement, "linear", False) or measurement.H is None:
+            raise InputError(f"measurement must be linear (y = H x + D v); got {type(measurement).__name__}")
+        n, m = system.n, measurement.n_meas
+        self.theta = as_nonnegative("theta", theta)
+        self.F = np.asarray(system.Phi, dtype=float)
+        self.Gamma = np.asarray(system.Gamma, dtype=float)
+        self.H = np.asarray(measurement.H, dtype=float)
+        self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
+        self.R = as_covariance("R", measurement.R if R is None else R, m, definite=True)
+        self.P0 = as_covariance("P0", P0, n, definite=True)
+        self.L = np.eye(n) if L is None else as_matrix("L", L, (None, n))
+        l = self.L.shape[0]
+        self.S = np.eye(l) if S is None else as_covariance("S", S, l, definite=False)
+        if not isinstance(uses_input, (bool, np.bool_)):
+            raise InputError(f"uses_input must be True or False; got {uses_input!r}")
+        self.uses_input = bool(uses_input)
+        self.on_violation = as_choice("on_violation", on_violation, ON_VIOLATION)
+        self._HtRi = np.linalg.solve(self.R, self.H).T  # Hᵀ R⁻¹
+        W = self._HtRi @ self.H
+        self.Sbar = self.L.T @ self.S @ self.L
+        self._G = 0.5 * (W + W.T) - self.theta * 0.5 * (self.Sbar + self.Sbar.T)
+        self._theta_max = None
+
+    # -- the data-independent recursion --------------------------------------------
+
+    def theta_max(self):
+        """Largest θ with a steady state (:func:`hinfnav.analysis.max_admissible_theta`), cached."""
+        if self._theta_max is None:
+            self._theta_max = max_admissible_theta(self.F, self.H, self.Q, self.R, L=self.L, S=self.S)
+        return self._theta_max
+
+    def riccati_step(self, P, k=0):
+        """One step of the recursion: ``(K, P_next, margin, ok)`` (see the module notes)."""
+        try:
+            C = np.linalg.cholesky(P)
+        except np.linalg.LinAlgError:
+            lam, V = np.linalg.eigh(0.5 * (P + P.T))
+            C = V * np.sqrt(np.clip(lam, 0.0, None))
+        N = np.eye(P.shape[0]) + C.T @ self._G @ C
+        N = 0.5 * (N + N.T)
+        margin = float(np.linalg.eigvalsh(N)[0])
+        try:
+            Nc = np.linalg.cholesky(N)
+            ok = True
+            NiCt = np.linalg.solve(Nc.T, np.linalg.solve(Nc, C.T))  # N⁻¹ Cᵀ
+        except np.linalg.LinAlgError:
+            ok = False
+            if self.on_violation == "raise":
+                self._violation(k, margin)
+            NiCt = np.linalg.solve(N, C.T)
+        CNC = C @ NiCt
+        CNC = 0.5 * (CNC + CNC.T)
+        K = CNC @ self._HtRi
+        P_next = self.F @ CNC @ self.F.T + self.Q
+        return K, 0.5 * (P_next + P_next.T), margin, ok
+
+    def _violation(self, k, margin):
+        try:
+            tmax = self.theta_max()
+            hint = (f"the steady state admits theta < {tmax:.6g}" if np.isfinite(tmax)
+                    else "every theta has a steady state; the violation comes from P0")
+        except HinfnavError:
+            hint = "even theta = 0 has no steady state ((F, H) not detectable?)"
+        raise InputError(
+            f"filter {self.name!r}: theta = {self.theta:g} violates the existence condition "
+            f"P_k^-1 - theta*S̄ + H^T R^-1 H > 0 at step {k} (smallest eigenvalue of C^T(P^-1 - theta*S̄ + "
+            f"H^T R^-1 H)C: {margin:.3g}); choose a smaller theta ({hint}) or a smaller P0"
+        )
+
+    # -- the step contract --------------------------------------------------------------
+
+    def start(self, xhat0, P0=None, runs=1):
+        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
+        x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
+        return FilterState(x=x, P=P, extra={"steady": None})
+
+    def _gain(self, P, k, steady):
+        """``(K, P_next, margin, ok, steady)`` at step k; keeps the steady gain once P has converged."""
+        if steady is not None:
+            K, P_fixed, margin, ok = steady
+            return K, P_fixed, margin, ok, steady
+        K, P_next, margin, ok = self.riccati_step(P, k)
+        if ok and np.linalg.norm(P_next - P) <= _FREEZE * np.linalg.norm(P):
+            steady = (K, P, margin, ok)
+            P_next = P
+        return K, P_next, margin, ok, steady
+
+    def update(self, state, y):
+        y = np.asarray(y, dtype=float)
+        runs = state.x.shape[0]
+        K, P_next, margin, ok, steady = self._gain(state.P, state.k, state.extra.get("steady"))
+        innovation = y - state.x @ self.H.T
+        diag = {
+            "innovation": innovation,
+            "existence_margin": np.full(runs, margin),
+            "existence_ok": np.full(runs, ok),
+        }
+        extra = dict(state.extra, innovation=innovation, gain=K, P_next=P_next, steady=steady)
+        new = FilterState(x=state.x, P=state.P, k=state.k, extra=extra)
+        return new, StepOutput(xhat=state.x, P=np.broadcast_to(state.P, (runs,) + state.P.shape), diagnostics=diag)
+
+    def predict(self, state, u=None):
+        if self.uses_input and u is None:
+            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+        if "gain" not in state.extra:
+            raise InputError(f"filter {self.name!r}: predict needs an update first (the gain uses y_k)")
+        FK = self.F @ state.extra["gain"]
+        x = state.x @ self.F.T + state.extra["innovation"] @ FK.T
+        if self.uses_input:
+            x = x + np.asarray(u, dtype=float) @ self.Gamma.T
+        extra = {"steady": state.extra.get("steady")}
+        return FilterState(x=x, P=state.extra["P_next"], k=state.k + 1, extra=extra)
+
+    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
+        """Batch path: the (data-independent) gain sequence once, then all runs at once; same numbers as the steps."""
+        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
+                                             self.n_input if self.uses_input else None)
+        runs, n1, _ = y.shape
+        state = self.start(xhat0, P0, runs)
+        P, steady = state.P, None
+        P_hist = np.empty((n1,) + P.shape) if keep_covariance else None
+        margins, oks, FKs = np.empty(n1), np.empty(n1, dtype=bool), []
+        for k in range(n1):
+            if keep_covariance:
+                P_hist[k] = P
+            K, P, margins[k], oks[k], steady = self._gain(P, k, steady)
+            FKs.append(self.F @ K)
+            if steady is not None:  # the gain no longer changes: P_j = P_k for j > k
+                if keep_covariance:
+                    P_hist[k + 1:] = P
+                margins[k + 1:], oks[k + 1:] = margins[k], oks[k]
+                break
+        xhat = np.empty((runs, n1, self.n_state))
+        innov = np.empty(y.shape) if diagnostics else None
+        x = state.x
+        Ft, Ht, Gt = self.F.T, self.H.T, self.Gamma.T
+        for k in range(n1):
+            xhat[:, k] = x
+            e = y[:, k] - x @ Ht
+            if diagnostics:
+                innov[:, k] = e
+            if k < n1 - 1:
+                FK = FKs[min(k, len(FKs) - 1)]
+                x = x @ Ft + e @ FK.T
+                if self.uses_input:
+                    x = x + u[:, k] @ Gt
+        out_P = None
+        if keep_covariance:
+            P_hist.setflags(write=False)
+            out_P = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
+        diag = {}
+        if diagnostics:
+            diag = {"innovation": innov, "existence_margin": np.broadcast_to(margins, (runs, n1)).copy(),
+                    "existence_ok": np.broadcast_to(oks, (runs, n1)).copy()}
+        return EstimateHistory(xhat=xhat, P=out_P, state=self.system.state, diagnostics=diag)

@@ -1,0 +1,172 @@
+"""``python -m hinfnav reproduce --paper attitude2018``: paper 002's Figs 1–9, its claims measured, the chaser study."""
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ...core.exceptions import InputError
+from ...core.validation import as_int_at_least
+from .chaser import chaser_study, format_chaser_table, plot_chaser
+from .claims import format_claims, measure_claims
+from .constants import CITATION, PAPER_OMEGA_E_DEG_S, orbit_rate
+from .figures import (
+    fig1,
+    fig2,
+    fig3,
+    fig4,
+    fig5,
+    fig6,
+    fig7,
+    fig8,
+    fig9,
+    fig_q_sweep,
+    fig_tuning,
+)
+from .scenario import Scenario
+from .studies import attitude_study
+
+__all__ = ["NOTEBOOKS", "reproduce", "stats_entry", "summarize", "to_json"]
+
+#: The notebooks of paper 002's decade.
+NOTEBOOKS = "2[0-9]_*.ipynb"
+
+
+def to_json(obj):
+    """Plain JSON types from numpy scalars and arrays (recursively)."""
+    if isinstance(obj, dict):
+        return {str(k): to_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_json(obj.tolist())
+    if isinstance(obj, (np.floating, np.integer, np.bool_)):
+        return obj.item()
+    return obj
+
+
+def stats_entry(s):
+    """The JSON record of one :class:`~.studies.FilterStats`."""
+    return {
+        "euler_rms_deg": [float(v) for v in s.euler_rms_deg],
+        "torque_rms_Nm": [float(v) for v in s.torque_rms_Nm],
+        "rate_rms_rad_s": [float(v) for v in s.rate_rms],
+        "euler_oscillating_deg": [float(v) for v in s.euler_bias_deg],
+        "euler_random_deg": [float(v) for v in s.euler_random_deg],
+        "torque_oscillating_Nm": [float(v) for v in s.torque_bias_Nm],
+        "torque_random_Nm": [float(v) for v in s.torque_random_Nm],
+        "euler_ci95_deg": list(s.ci95("euler")),
+        "torque_ci95_Nm": list(s.ci95("torque")),
+        "params": s.params,
+    }
+
+
+def summarize(study, claims, chaser=None):
+    """The summary dict written to ``summary.json``."""
+    sc = study.scenario
+    omega = np.degrees(orbit_rate(sc.altitude_m))
+    smallest = study.q_sweep["aekf"][0]
+    out = {
+        "paper": CITATION,
+        "settings": dict(study.settings, J_kg_m2=sc.J, references=sc.references, R=sc.R, T0_Nm=sc.T0,
+                         euler0_deg=sc.euler0_deg, P0_std=sc.P0_std, orbits=sc.orbits,
+                         error_measure="per-axis RMS over rms_window_s (the last orbit), pooled over runs; Euler "
+                                       "angles (3-2-1) of dq = q x qhat^-1 in deg"),
+        "orbit_rate_deg_s": float(omega),
+        "orbit_rate_check": {"paper_deg_s": PAPER_OMEGA_E_DEG_S, "relative_difference": float(omega / PAPER_OMEGA_E_DEG_S - 1),
+                             "note": "sqrt(mu/(R_E + 650 km)^3) with R_E = 6371 km, mu = 3.986006e14 m^3/s^2"},
+        "orbital_period_s": float(sc.orbital_period),
+        "torque_periods_s": [float(p) for p in sc.orbital_period / np.array([6.0, 4.0, 8.0])],
+        "q_sweep": [{"Q": q, "aekf": stats_entry(a), "astekf": stats_entry(s)}
+                    for q, a, s in zip(study.q_sweep["Q"], study.q_sweep["aekf"], study.q_sweep["astekf"])],
+        "aekf": stats_entry(study.main["aekf"]),
+        "astekf": stats_entry(study.main["astekf"]),
+        "aaekf": stats_entry(study.main["aaekf"]),
+        "torque_error_rate_correlation": float(np.mean(smallest.corr_rate)),
+        "torque_error_rate_correlation_axes": [float(v) for v in smallest.corr_rate],
+        "torque_error_rate_correlation_Q": float(study.q_sweep["Q"][0]),
+        "st_grid": [{"rho": s.params["rho"], "beta": s.params["beta"], **stats_entry(s)} for s in study.st_grid],
+        "epsilon_sweep": [{"epsilon": s.params["epsilon"], **stats_entry(s)} for s in study.epsilon_sweep],
+        "window_sweep": [{"window": s.params["window"], **stats_entry(s)} for s in study.window_sweep],
+        "claims": claims,
+    }
+    if chaser is not None:
+        out["chaser"] = {"rows": chaser.rows, "sweeps": chaser.sweeps, "settings": chaser.settings}
+    return to_json(out)
+
+
+def _save(fig, out_dir, name):
+    for ext in ("png", "pdf"):
+        fig.savefig(Path(out_dir) / f"{name}.{ext}", dpi=110)
+
+
+def _execute_notebooks(out_dir):
+    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
+    paths = sorted(nb_dir.glob(NOTEBOOKS))
+    if not paths:
+        raise InputError(f"notebooks=True needs the repository's notebooks/ folder; no {NOTEBOOKS} in {nb_dir}")
+    cmd = [sys.executable, "-m", "nbconvert", "--to", "notebook", "--execute", "--output-dir", str(out_dir)]
+    subprocess.run(cmd + [str(p) for p in paths], check=True, cwd=nb_dir)
+    return [Path(out_dir) / p.name for p in paths]
+
+
+def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=False, progress=True, scenario=None,
+              chaser=True):
+    """Regenerate paper 002's Figs 1–9, the sweeps, the claims and the chaser study into ``out_dir``.
+
+    Writes ``fig1`` … ``fig9``, ``fig10_q_sweep``, ``fig11_tuning`` and (with
+    ``chaser``) ``fig12_chaser`` as PNG and PDF, and ``summary.json``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+    seed : int
+    runs : int
+        Monte Carlo runs of the three filters at the paper's settings and of
+        the chaser comparison; the sweeps use the first min(runs, 4) (attitude)
+        and min(runs, 5) (chaser) runs of the same truths.
+    notebooks : bool
+        Also execute notebooks ``2x_*.ipynb`` into ``out_dir``.
+    progress : bool
+    scenario : Scenario, optional
+    chaser : bool
+        Run item 5 (Sun 2011's chaser) too.
+
+    Returns
+    -------
+    dict
+        The summary written to ``summary.json``.
+    """
+    scenario = Scenario() if scenario is None else scenario
+    runs = as_int_at_least("runs", runs, 1)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    study = attitude_study(scenario, runs=runs, seed=seed, progress=progress)
+    claims = measure_claims(study)
+    ch = chaser_study(runs=runs, seed=seed) if chaser else None
+    figs = {"fig1": lambda: fig1(scenario), "fig2": lambda: fig2(study), "fig3": lambda: fig3(study),
+            "fig4": lambda: fig4(study), "fig5": lambda: fig5(study), "fig6": lambda: fig6(study),
+            "fig7": lambda: fig7(study), "fig8": lambda: fig8(study), "fig9": lambda: fig9(study),
+            "fig10_q_sweep": lambda: fig_q_sweep(study), "fig11_tuning": lambda: fig_tuning(study)}
+    if ch is not None:
+        figs["fig12_chaser"] = lambda: plot_chaser(ch)
+    for name, make in tqdm(figs.items(), disable=not progress, desc="figures", unit="fig"):
+        _save(make(), out, name)
+    summary = summarize(study, claims, ch)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    if notebooks:
+        _execute_notebooks(out)
+    if progress:
+        print(f"\norbit rate {summary['orbit_rate_deg_s']:.14f} deg/s (paper {PAPER_OMEGA_E_DEG_S}), "
+              f"relative difference {summary['orbit_rate_check']['relative_difference']:.1e}")
+        print(format_claims(claims))
+        if ch is not None:
+            print("\nSun 2011's chaser, control law unknown (mean of per-run RMS over axes, 95 % interval):")
+            print(format_chaser_table(ch))
+        print(f"\nwrote {out.resolve()} in {time.perf_counter() - t0:.0f} s")
+    return summary

@@ -1,0 +1,151 @@
+"""The two filters of Shi & Wang (2018), registered by name: the EKF and the Huber-based filter.
+
+=================  ==========================================================
+name               estimator
+=================  ==========================================================
+``ekf_converted``  the EKF of the comparison: Hill/CW prediction with the
+                   measured control acceleration, Kalman update on the
+                   indirect position measurement (20)–(22), R_k = J R Jᵀ at
+                   each reading (fits this paper's scenario only)
+``hbf``            the Huber-based filter: the same filter with the Huber
+                   update (:class:`hinfnav.estimators.HuberFilter`). Fits any
+                   scenario that has a Kalman filter to robustify (see
+                   :func:`build_hbf`), e.g. Sun 2011's chaser
+=================  ==========================================================
+
+Both filters know the true Q and the true sensor errors unless told others
+(``sigma_range``, ``sigma_angle``: the sensor errors the filter assumes, for
+the mistuning study), so under Gaussian noise the EKF is (to first order in
+the conversion) the optimal filter.
+"""
+
+import numpy as np
+
+from ...core.exceptions import InputError
+from ...core.validation import as_choice, as_positive
+from ...estimators.huber_filter import HuberFilter
+from ...estimators.kalman import ExtendedKalmanFilter
+from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
+from .constants import GAMMA
+from .scenario import Scenario
+
+__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "HBF_BASES"]
+
+#: How the filters use the readings: converted to position (the paper's indirect measurement) or directly.
+MEASUREMENTS = ("converted", "direct")
+
+#: Kalman filters that ``hbf`` robustifies on other papers' scenarios, tried in this order
+#: (Sun 2011: the EKF told the applied thrust, as Shi & Wang's filters know the control acceleration).
+HBF_BASES = ("ekf_known_input", "ekf")
+
+
+def EKF(scenario, *, measurement="converted", sigma_range=None, sigma_angle=None, Q=None, P0=None,  # noqa: N802
+        output="filtered", name=None):
+    """The EKF of Shi & Wang (2018) on :class:`~hinfnav.papers.shi2018.Scenario`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    measurement : {"converted", "direct"}
+        ``"converted"`` (the paper's): readings converted to position, a
+        linear measurement with R_k = J(y_k) R Jᵀ. ``"direct"``: the
+        range/angle readings with their own Jacobian (an extension).
+    sigma_range, sigma_angle : float, optional
+        Sensor errors (1σ; m, rad) the filter assumes; default the true ones.
+    Q : array_like, shape (6, 6), optional
+        Process-noise covariance per step; default the true ``Γ Γᵀ σ_a²``.
+    P0 : array_like, shape (6, 6), optional
+        Initial covariance; default the scenario's.
+    output : {"filtered", "predicted"}
+    name : str, optional
+
+    Returns
+    -------
+    hinfnav.estimators.ExtendedKalmanFilter
+    """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Shi 2018 Scenario; got {type(scenario).__name__}")
+    measurement = as_choice("measurement", measurement, MEASUREMENTS)
+    sr = None if sigma_range is None else as_positive("sigma_range", sigma_range)
+    sa = None if sigma_angle is None else as_positive("sigma_angle", sigma_angle)
+    model = scenario.filter_measurement(sr, sa) if measurement == "converted" else scenario.sensor(sr, sa)
+    if name is None:
+        name = "ekf_converted" if measurement == "converted" else "ekf_direct"
+    return ExtendedKalmanFilter(scenario.system(), model, P0=scenario.P0 if P0 is None else P0, Q=Q,
+                                uses_input=True, output=output, name=name)
+
+
+def HBF(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, name=None, **ekf_options):  # noqa: N802
+    """The Huber-based filter of Shi & Wang (2018): :func:`EKF` with the Huber update.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    gamma : float
+        Huber threshold (1.345).
+    tol, max_iter
+        Of the M-estimation.
+    name : str, optional
+    **ekf_options
+        As for :func:`EKF` (``measurement``, ``sigma_range``, ``sigma_angle``, ``Q``, ``P0``, ``output``).
+    """
+    if name is None:
+        name = "hbf" if ekf_options.get("measurement", "converted") == "converted" else "hbf_direct"
+    return HuberFilter.from_ekf(EKF(scenario, **ekf_options), gamma=gamma, tol=tol, max_iter=max_iter, name=name)
+
+
+def _base_name(scenario):
+    """The first of :data:`HBF_BASES` registered and fitting ``scenario`` (None if none)."""
+    known = registered_estimators()
+    for name in HBF_BASES:
+        if name in known and estimator_entry(name).fits(scenario):
+            return name
+    return None
+
+
+def _fits_hbf(scenario):
+    if isinstance(scenario, Scenario):
+        return True
+    if _base_name(scenario) is not None:
+        return True
+    return hasattr(scenario, "truth_model") and hasattr(scenario, "xhat0") and hasattr(scenario, "P0")
+
+
+def build_hbf(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, base=None, **options):
+    """The registry's ``hbf`` on any scenario it fits.
+
+    * Shi & Wang (2018)'s scenario: :func:`HBF`.
+    * a scenario with a registered Kalman filter (``base``, default the
+      first of :data:`HBF_BASES` that fits, e.g. Sun 2011's
+      ``ekf_known_input``): that filter with the Huber update — same model,
+      Q, R, P₀ and input use; ``options`` go to its builder.
+    * otherwise a scenario with ``truth_model()`` (a LinearSystem and a
+      measurement), ``xhat0`` and ``P0``: the HBF on the truth's system and
+      measurement, Q = B Bᵀ, R = D Dᵀ, told the input.
+    """
+    if isinstance(scenario, Scenario):
+        if base is not None:
+            raise InputError("base applies only to scenarios of other papers")
+        return HBF(scenario, gamma=gamma, tol=tol, max_iter=max_iter, **options)
+    base = _base_name(scenario) if base is None else base
+    if base is not None:
+        ekf = build_estimator(base, scenario, **options)
+        return HuberFilter.from_ekf(ekf, gamma=gamma, tol=tol, max_iter=max_iter, name="hbf")
+    if not _fits_hbf(scenario):
+        raise InputError(f"hbf needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}) or with "
+                         f"truth_model(), xhat0 and P0; {type(scenario).__name__} has neither")
+    model = scenario.truth_model()
+    return HuberFilter(model.system, model.measurement, P0=np.asarray(scenario.P0, dtype=float),
+                       gamma=gamma, tol=tol, max_iter=max_iter, uses_input=True, name="hbf", **options)
+
+
+def _build_ekf(scenario, **options):
+    return EKF(scenario, **options)
+
+
+register_estimator("hbf", build_hbf, fits=_fits_hbf,
+                   description="Huber-based filter (Karlgaard & Schaub 2007; Shi & Wang 2018): the scenario's Kalman "
+                               "filter with Huber's M-estimation as its update")
+register_estimator("ekf_converted", _build_ekf, fits=lambda scenario: isinstance(scenario, Scenario),
+                   description="EKF on the converted (indirect) position measurement, R_k = J R J^T "
+                               "(Shi & Wang 2018's comparison)")

@@ -1,0 +1,261 @@
+"""The closed loop of Section 3: plant, sensors, Algorithm 3, ADRC (or PID), actuators, vectorized over runs.
+
+At each t_k (h = 0.1 s), with the default ``timing="posterior"``:
+
+1. the sensors read ``Y_k = C_o X_o,k + d_k`` (5) and the accelerometers
+   ``a_k = (K_trans r_k + D_trans ṙ_k)/m_tm + (F_Csc,k−1 + w_F,k−1 + F_Dsc(t_k))/m_sc + d_a,k``
+   (11) just before the new command (the actuator still holds u_{k−1}),
+   clipped to ±6e-6 m/s² (14);
+2. Algorithm 3 updates with (Y_k, a_k), told the input u_{k−1} the reading contains;
+3. the controller computes u_k from the filtered estimate X̂_k and the
+   attitude command; u_k is clipped to ±ρ and held over [t_k, t_{k+1});
+4. Algorithm 3 predicts with u_k, and the plant moves by the exact ZOH
+   discretization of (4) with ``u_k + w_k + f(t_k)`` held.
+
+With ``timing="prior"`` (13) is read literally — the accelerometer reading of
+t_k contains the command u_k — so u_k is computed first, from the prior
+estimate X̂⁻_k, and the compensation of the disturbance lags one step.
+
+Alongside, without acting on the loop, the standalone estimators of Figs 5-7
+run on the same readings: Algorithm 1 and Algorithm 2 in its three variants
+L1 (truncated-normal update), L2 (ideal: fed the unclipped readings, never
+clipped) and L3 (skips clipped readings), batched into one array.
+
+Randomness: run r draws from the r-th child of ``numpy.random.default_rng(seed)``,
+in blocks of ``BLOCK`` steps, w (9) then d (9) then d_a (3) per block: the same
+seed gives the same numbers whatever the number of runs.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from ...core.progress import bar_disabled
+from ...core.validation import as_choice, as_int_at_least
+from ...sim.truth import child_rngs
+from .constants import ACCELEROMETER_RANGE, D_TRANS, K_TRANS, M_SC, M_TM
+from .filters import build_alg1, build_alg2, build_fused
+from .model import MEASURED_INDICES, disturbance
+from .scenario import CONTROLLERS, check_scenario
+
+__all__ = ["LoopResult", "run_closed_loop", "residual_acceleration", "BLOCK", "PASSIVE"]
+
+#: Steps per block of noise drawn at once.
+BLOCK = 10_000
+#: The standalone estimators run alongside the loop (Figs 5-7).
+PASSIVE = ("alg1", "L1", "L2", "L3")
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResult:
+    """Histories of one closed-loop simulation (SI units).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time, s.
+    x : ndarray, shape (runs, n, 18)
+        Plant state ``[φ_sc, φ̇_sc, r, ṙ, φ_rel, φ̇_rel]``.
+    f : ndarray, shape (n, 9)
+        True disturbances ``[T_Dsc, F_Dsc, T_Dtm]``.
+    u : ndarray, shape (runs, n, 9)
+        Applied (clipped) inputs.
+    drive : ndarray, shape (runs, n, 9)
+        What acts on the plant, ``u + w + f``.
+    acc : ndarray, shape (runs, n, 3)
+        Accelerometer readings before the range (14) is applied.
+    xhat : ndarray, shape (runs, n, 27)
+        Algorithm 3's filtered estimate.
+    passive : dict
+        ``alg1``, ``L1``, ``L2``, ``L3`` → filtered estimates of the drag-free
+        block ``[r (3), ṙ (3), F_Dsc (3)]``, shape (runs, n_passive, 9).
+    reference : ndarray, shape (n, 3)
+        Attitude command, rad.
+    settings : dict
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    f: np.ndarray
+    u: np.ndarray
+    drive: np.ndarray
+    acc: np.ndarray
+    xhat: np.ndarray
+    passive: dict = field(default_factory=dict)
+    reference: np.ndarray = None
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def runs(self):
+        return self.x.shape[0]
+
+    @property
+    def acc_clipped(self):
+        """The readings the filters receive, clipped to the range (14)."""
+        return np.clip(self.acc, *ACCELEROMETER_RANGE)
+
+    @property
+    def saturated(self):
+        """Which readings sat at a bound, (runs, n, 3)."""
+        lo, up = ACCELEROMETER_RANGE
+        return (self.acc <= lo) | (self.acc >= up)
+
+    @property
+    def w(self):
+        """Input noise, (runs, n, 9)."""
+        return self.drive - self.u - self.f
+
+    def true_extended(self):
+        """The true extended state (27) at each step, from x and f."""
+        X = np.empty(self.x.shape[:2] + (27,))
+        X[..., 0:6] = self.x[..., 0:6]
+        X[..., 6:9] = self.f[:, 0:3]
+        X[..., 9:15] = self.x[..., 6:12]
+        X[..., 15:18] = self.f[:, 3:6]
+        X[..., 18:24] = self.x[..., 12:18]
+        X[..., 24:27] = self.f[:, 6:9]
+        return X
+
+    def dragfree_truth(self):
+        """True ``[r, ṙ, F_Dsc]`` (runs, n, 9), the block the drag-free estimators report."""
+        return np.concatenate([self.x[..., 6:12], np.broadcast_to(self.f[:, 3:6], self.x.shape[:2] + (3,))], axis=-1)
+
+
+def residual_acceleration(result, reading="test_mass"):
+    """The translational residual acceleration of Fig 12, m/s², shape (runs, n, 3).
+
+    Parameters
+    ----------
+    result : LoopResult
+    reading : {"test_mass", "relative", "accelerometer"}
+        ``test_mass``: the non-conservative acceleration on the test mass, the
+        coupling ``−(K_trans r + D_trans ṙ)/m_tm``; ``relative``: the true
+        relative acceleration ``r̈`` of (2) (what the accelerometer senses,
+        sign aside); ``accelerometer``: the unclipped reading, noise included.
+    """
+    as_choice("residual reading", reading, ("test_mass", "relative", "accelerometer"))
+    r, v = result.x[..., 6:9], result.x[..., 9:12]
+    coupling = -(r @ K_TRANS.T + v @ D_TRANS.T) / M_TM
+    if reading == "test_mass":
+        return coupling
+    if reading == "accelerometer":
+        return result.acc
+    return coupling - result.drive[..., 3:6] / M_SC
+
+
+class _Bank:
+    """L1, L2, L3 stacked as rows of one Algorithm 2 array (runs × 3 variants)."""
+
+    def __init__(self, sc, runs):
+        self.alg = build_alg2(sc, mode="truncated")
+        self.runs = runs
+        self.X = np.zeros((3 * runs, 3, 3))
+        self.P = np.broadcast_to(self.alg.P0, (3 * runs, 3, 3, 3)).copy()
+        self.skip = np.repeat([False, False, True], runs)  # rows: L1 (runs), L2 (runs), L3 (runs)
+        self.ideal = np.repeat([False, True, False], runs)
+
+    def step(self, acc_raw, acc_clipped, u_f):
+        y = np.concatenate([acc_clipped, acc_raw, acc_clipped])
+        sat = self.alg.flags(y) & ~self.ideal[:, None]
+        uu = np.concatenate([u_f] * 3)
+        X, P, _, _, _ = self.alg.kernel_update(self.X, self.P, y, uu, sat=sat, skip=self.skip)
+        self.X, self.P = self.alg.kernel_predict(X, P, uu)
+        return self.alg.to_full(X).reshape(3, self.runs, 9)
+
+
+def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True, passive_steps=100_000,
+                    progress=False):
+    """Simulate the closed loop of Section 3 (see the module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Length, readings, ``steady_tol`` (gains frozen once converged).
+    controller : {"adrc", "adrc_pid", "pid"}
+    runs : int
+    seed : int or numpy.random.Generator
+    passive : bool
+        Also run the standalone estimators of Figs 5-7 (Algorithm 1, L1, L2, L3).
+    passive_steps : int
+        Over the first ``passive_steps`` samples only (their cost is a third of the loop's).
+    progress : bool
+
+    Returns
+    -------
+    LoopResult
+    """
+    sc = check_scenario(scenario)
+    as_choice("controller", controller, CONTROLLERS)
+    runs = as_int_at_least("runs", runs, 1)
+    if isinstance(seed, np.random.Generator):
+        seed = int(seed.integers(2**63))
+    rngs = child_rngs(seed, runs)
+    m = sc.model
+    n1 = sc.n_steps + 1
+    t = np.arange(n1) * sc.dt
+    f = disturbance(t, sc.w_d)
+    ref = sc.attitude_reference(n1)
+    law = sc.controller(controller)
+    fused = build_fused(sc, steady_tol=sc.steady_tol)
+    lo, up = ACCELEROMETER_RANGE
+    sd_w, sd_d, sd_a = sc.input_std, sc.sensor_std, sc.accel_std
+    PhiT, GamT, CaT = m.Phi.T, m.Gamma.T, m.accel_C.T
+
+    x_h = np.empty((runs, n1, 18))
+    u_h, g_h, xhat_h, acc_h = (np.empty((runs, n1, k)) for k in (9, 9, 27, 3))
+    clipped = 0
+    n_passive = min(n1, as_int_at_least("passive_steps", passive_steps, 0)) if passive else 0
+    pas = {name: np.empty((runs, n_passive, 9)) for name in PASSIVE} if n_passive else {}
+    if n_passive:
+        a1 = build_alg1(sc, steady_tol=sc.steady_tol)
+        s1 = a1.start(sc.xhat0, None, runs)
+        bank = _Bank(sc, runs)
+    x = np.broadcast_to(sc.x0, (runs, 18)).copy()
+    fs = fused.start(sc.xhat0, None, runs)
+    cs = law.start(runs)
+    prior = sc.timing == "prior"
+    u_prev = np.zeros((runs, 9))  # input and input noise of the hold interval that ends at t_k
+    w_prev = np.zeros((runs, 9))
+    steady_at = None
+    for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({controller})", unit="step",
+                  mininterval=1.0, leave=False):
+        j = k % BLOCK
+        if j == 0:
+            nb = min(BLOCK, n1 - k)
+            blocks = [[rng.standard_normal((nb, p)) for p in (9, 9, 3)] for rng in rngs]
+            W = np.stack([b[0] for b in blocks]) * sd_w
+            Dn = np.stack([b[1] for b in blocks]) * sd_d
+            Da = np.stack([b[2] for b in blocks]) * sd_a
+        fk, wk = f[k], W[:, j]
+        if prior:
+            u, ucmd, cs = law(fs.x, ref[k], cs)
+            u_read, w_read = u, wk
+        else:
+            u_read, w_read = u_prev, w_prev
+        Y = x[:, MEASURED_INDICES] + Dn[:, j]
+        a_raw = x @ CaT + (u_read[:, 3:6] + w_read[:, 3:6] + fk[3:6]) * (1.0 / M_SC) + Da[:, j]
+        a_c = np.clip(a_raw, lo, up)
+        fs = fused.feed_input(fs, u_read)
+        fs, out = fused.update(fs, np.concatenate([Y, a_c], axis=1))
+        if not prior:
+            u, ucmd, cs = law(out.xhat, ref[k], cs)
+        if np.any(u != ucmd):
+            clipped += 1
+        g = u + wk + fk
+        if steady_at is None and fs.extra["steady"] is not None:
+            steady_at = k
+        x_h[:, k], u_h[:, k], g_h[:, k], xhat_h[:, k], acc_h[:, k] = x, u, g, out.xhat, a_raw
+        if k < n_passive:
+            s1, o1 = a1.update(s1, Y)
+            pas["alg1"][:, k] = o1.xhat[:, 9:18]
+            s1 = a1.predict(s1, u)
+            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(a_raw, a_c, u_read[:, 3:6])
+        fs = fused.predict(fs, u)
+        x = x @ PhiT + g @ GamT
+        u_prev, w_prev = u, wk
+    settings = dict(sc.readings, controller=controller, runs=runs, seed=seed, n_steps=sc.n_steps, dt=sc.dt, w_d=sc.w_d,
+                    steady_tol=sc.steady_tol, fused_steady_from_step=steady_at, clipped_input_steps=clipped,
+                    theta_alg1=float(fused.alg1.theta), theta_alg2=fused.alg2.theta.tolist())
+    return LoopResult(t=t, x=x_h, f=f, u=u_h, drive=g_h, acc=acc_h, xhat=xhat_h, passive=pas, reference=ref,
+                      settings=settings)

@@ -1,0 +1,229 @@
+"""Measurements on closed-loop results: disturbance-estimation errors, spectra, step response, periodic rejection.
+
+Every statistic names its window and units. The residual-acceleration
+spectrum is Welch's (``scipy.signal.welch``: Hann window, 50 % overlap,
+one-sided density), averaged over runs, as an amplitude spectral density in
+m·s⁻²/√Hz.
+"""
+
+import numpy as np
+from scipy.signal import welch
+
+from ...core.exceptions import InputError
+from ...core.validation import as_int_at_least
+from .constants import REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
+from .loop import residual_acceleration
+
+__all__ = [
+    "NPERSEG",
+    "amplitude_spectral_density",
+    "band_statistics",
+    "residual_spectrum",
+    "disturbance_errors",
+    "estimation_errors",
+    "periodic_amplitude",
+    "step_response",
+    "saturation_summary",
+    "linear_loop_radius",
+]
+
+#: Welch segment length: 2^15 samples = 3277 s, resolution 0.31 mHz (four bins per mHz at the band's low edge).
+NPERSEG = 2**15
+
+
+def amplitude_spectral_density(a, dt, nperseg=NPERSEG):
+    """One-sided amplitude spectral density of ``a`` (runs, n, c) along time, PSD averaged over runs.
+
+    Returns
+    -------
+    f : ndarray, shape (n_f,)
+        Frequency, Hz.
+    asd : ndarray, shape (n_f, c)
+        unit/√Hz.
+    """
+    a = np.asarray(a, dtype=float)
+    if a.ndim != 3:
+        raise InputError(f"a must have shape (runs, n_samples, channels); got {a.shape}")
+    nperseg = as_int_at_least("nperseg", nperseg, 16)
+    if a.shape[1] < nperseg:
+        raise InputError(f"the record ({a.shape[1]} samples) is shorter than nperseg = {nperseg}")
+    f, P = welch(a, fs=1.0 / dt, nperseg=nperseg, axis=1, window="hann", detrend="constant", scaling="density")
+    return f, np.sqrt(P.mean(axis=0))
+
+
+def band_statistics(f, asd, band=REQUIREMENT_BAND_HZ, line_hz=None, guard_bins=3):
+    """Largest and median ASD in a band, with and without the bins next to a known line.
+
+    Parameters
+    ----------
+    f : ndarray, shape (n_f,)
+    asd : ndarray, shape (n_f,) or (n_f, c)
+        The largest over channels is taken.
+    band : (float, float)
+        Hz, inclusive.
+    line_hz : float, optional
+        Frequency of a deterministic line (the disturbance's ω_d/2π).
+    guard_bins : int
+        Bins on each side of the line left out of ``floor_max`` (a Hann window's main lobe is ±2 bins).
+
+    Returns
+    -------
+    dict
+        ``max``, ``f_at_max_hz``, ``median``, ``floor_max`` (line bins excluded), ``requirement``,
+        ``below_requirement`` (max), ``floor_below_requirement``.
+    """
+    asd = np.asarray(asd, dtype=float)
+    A = asd.max(axis=1) if asd.ndim == 2 else asd
+    inb = (f >= band[0]) & (f <= band[1])
+    if not inb.any():
+        raise InputError(f"no frequency bin in the band {band} Hz")
+    i = np.argmax(np.where(inb, A, -np.inf))
+    keep = inb.copy()
+    if line_hz is not None:
+        df = f[1] - f[0]
+        keep &= np.abs(f - line_hz) > guard_bins * df
+    floor = float(A[keep].max()) if keep.any() else None
+    return {"max": float(A[i]), "f_at_max_hz": float(f[i]), "median": float(np.median(A[inb])), "floor_max": floor,
+            "requirement": REQUIREMENT_ASD, "below_requirement": bool(A[i] < REQUIREMENT_ASD),
+            "floor_below_requirement": None if floor is None else bool(floor < REQUIREMENT_ASD), "band_hz": list(band),
+            "line_hz": line_hz, "guard_bins": guard_bins}
+
+
+def residual_spectrum(result, reading="test_mass", settle_s=2000.0, nperseg=NPERSEG):
+    """Welch ASD of the residual acceleration of a loop after ``settle_s``, with band statistics.
+
+    Returns
+    -------
+    dict
+        ``f`` (Hz), ``asd`` (n_f, 3), ``stats`` (see :func:`band_statistics`, the line at ω_d/2π),
+        ``reading``, ``window_s``, ``nperseg``.
+    """
+    k0 = int(round(settle_s / result.settings["dt"]))
+    a = residual_acceleration(result, reading)[:, k0:]
+    nper = min(nperseg, a.shape[1])
+    f, asd = amplitude_spectral_density(a, result.settings["dt"], nper)
+    w_d = result.settings.get("w_d")
+    stats = band_statistics(f, asd, line_hz=None if w_d is None else w_d / (2 * np.pi))
+    return {"f": f, "asd": asd, "stats": stats, "reading": reading,
+            "window_s": [float(result.t[k0]), float(result.t[-1])], "nperseg": nper}
+
+
+def disturbance_errors(estimate, truth, *, axis=0, window=None):
+    """Bias and RMS of one axis's disturbance estimate (N), over runs and a window of samples.
+
+    Parameters
+    ----------
+    estimate, truth : ndarray, shape (runs, n, 9)
+        Drag-free blocks ``[r, ṙ, F_Dsc]``.
+    axis : int
+        0, 1, 2 for x, y, z.
+    window : (int, int), optional
+        Sample indices [k0, k1); default all.
+    """
+    k0, k1 = (0, estimate.shape[1]) if window is None else window
+    e = estimate[:, k0:k1, 6 + axis] - truth[:, k0:k1, 6 + axis]
+    return {"disturbance_bias": float(e.mean()), "disturbance_rms": float(np.sqrt(np.mean(e**2))),
+            "window_steps": [int(k0), int(k1)]}
+
+
+def estimation_errors(result, *, axis=0, windows=None):
+    """Disturbance errors of every estimator of a loop (Algorithm 3, Algorithm 1, L1, L2, L3) per window.
+
+    Parameters
+    ----------
+    result : LoopResult
+    axis : int
+    windows : dict, optional
+        Name → (k0, k1) sample window; default ``{"all": whole passive span}``.
+
+    Returns
+    -------
+    dict
+        Estimator → window name → :func:`disturbance_errors`; also ``r_error_end_m`` (the
+        standalone filters' final displacement error) for Fig 6.
+    """
+    truth = result.dragfree_truth()
+    n_p = next(iter(result.passive.values())).shape[1] if result.passive else truth.shape[1]
+    windows = windows or {"all": (0, n_p)}
+    out = {}
+    fused = result.xhat[..., 9:18]
+    for name, est in [("fused", fused[:, :n_p])] + list(result.passive.items()):
+        tr = truth[:, : est.shape[1]]
+        out[name] = {w: disturbance_errors(est, tr, axis=axis, window=win) for w, win in windows.items()}
+        out[name]["r_error_end_m"] = float(np.abs(est[:, -1, axis] - tr[:, -1, axis]).mean())
+    return out
+
+
+def periodic_amplitude(signal, t, w):
+    """Amplitude of the component at ω (rad/s) of ``signal`` (runs, n) by least squares, averaged over runs."""
+    M = np.column_stack([np.sin(w * t), np.cos(w * t), np.ones_like(t)])
+    coef, *_ = np.linalg.lstsq(M, np.asarray(signal).T, rcond=None)
+    return float(np.hypot(coef[0], coef[1]).mean())
+
+
+def step_response(result, *, tolerance=0.05):
+    """The attitude step of Fig 11: settling, overshoot, and the relative-attitude excursion it causes.
+
+    Returns
+    -------
+    dict
+        Per axis (pitch, yaw, roll): ``settling_s`` (to within ``tolerance`` of the step, after the
+        command), ``overshoot`` (fraction of the step), ``rel_attitude_peak_rad`` (largest |φ_rel| in
+        the 1000 s after the command) and ``rel_attitude_before_rad`` (largest |φ_rel| in the 1000 s before).
+    """
+    ref = result.reference
+    on = np.nonzero(np.any(ref != 0, axis=1))[0]
+    if on.size == 0:
+        return {}
+    k_on = int(on[0])
+    k_off = int(on[-1]) + 1
+    dt = result.settings["dt"]
+    win = int(1000.0 / dt)
+    phi = result.x[:, k_on:k_off, 0:3].mean(axis=0)
+    out = {"step_on_s": float(result.t[k_on]), "step_off_s": float(result.t[min(k_off, len(result.t) - 1)]), "axes": {}}
+    for a, name in enumerate(("pitch", "yaw", "roll")):
+        err = np.abs(phi[:, a] - STEP_COMMAND[a])
+        outside = np.nonzero(err > tolerance * STEP_COMMAND[a])[0]
+        settle = float((outside[-1] + 1) * dt) if outside.size else 0.0
+        rel = result.x[:, :, 12 + a].mean(axis=0)
+        out["axes"][name] = {
+            "settling_s": settle,
+            "overshoot": float(max(0.0, (phi[:, a].max() - STEP_COMMAND[a]) / STEP_COMMAND[a])),
+            "rel_attitude_peak_rad": float(np.abs(rel[k_on:k_on + win]).max()),
+            "rel_attitude_before_rad": float(np.abs(rel[max(0, k_on - win):k_on]).max()),
+        }
+    return out
+
+
+def saturation_summary(result):
+    """How often the accelerometers saturated and the inputs were clipped."""
+    sat = result.saturated
+    any_sat = sat.any(axis=2)
+    idx = np.nonzero(any_sat.any(axis=0))[0]
+    return {"saturated_fraction": [float(v) for v in sat.mean(axis=(0, 1))],
+            "saturated_steps": int(any_sat.any(axis=0).sum()),
+            "last_saturated_step": int(idx[-1]) if idx.size else None,
+            "clipped_input_steps": int(result.settings.get("clipped_input_steps", 0))}
+
+
+def linear_loop_radius(kp, ki, kd, gain, integral_scale, h=0.1, slope=10.0):
+    """Spectral radius of one NLPID loop in fal's linear zone, the estimate equal to the truth.
+
+    The compensated plant is a double integrator ``ẍ = gain · u₀`` (gain 1 for
+    the attitude after (44), 1/m_sc for the drag-free loop after (45)), held
+    over h, with ``u₀ = slope (k_p e_p + k_i e_i + k_d e_d)``, ``e_p = −x``,
+    ``e_d = −ẋ`` and ``e_i(k) = e_i(k−1) + c e_p(k)`` (c = 1 as printed, h for
+    a rectangle-rule integral, ``ki = 0`` for none). Above 1: the loop diverges
+    from rest until fal's square-root zone limits it.
+    """
+    Ad = np.array([[1.0, h], [0.0, 1.0]])
+    Bd = np.array([h * h / 2, h]) * gain
+    c = integral_scale
+    K = slope * np.array([-kp - ki * c, -kd, ki])
+    A = np.zeros((3, 3))
+    A[:2, :2] = Ad + np.outer(Bd, K[:2])
+    A[:2, 2] = Bd * K[2]
+    A[2] = [-c, 0.0, 1.0]
+    if ki == 0:
+        A = A[:2, :2]
+    return float(np.max(np.abs(np.linalg.eigvals(A))))
