@@ -10,6 +10,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
+from ...core.outputs import to_json
 from ...core.validation import as_int_at_least
 from .chaser import chaser_study, format_chaser_table, plot_chaser
 from .claims import format_claims, measure_claims
@@ -34,19 +35,6 @@ __all__ = ["NOTEBOOKS", "reproduce", "stats_entry", "summarize", "to_json"]
 
 #: The notebooks of paper 002's decade.
 NOTEBOOKS = "2[0-9]_*.ipynb"
-
-
-def to_json(obj):
-    """Plain JSON types from numpy scalars and arrays (recursively)."""
-    if isinstance(obj, dict):
-        return {str(k): to_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_json(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_json(obj.tolist())
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return obj.item()
-    return obj
 
 
 def stats_entry(s):
