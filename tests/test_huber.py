@@ -156,3 +156,36 @@ def _bad_inputs():
 def test_bad_inputs_raise_input_error_naming_the_parameter(args, options, name):
     with pytest.raises(InputError, match=rf"\b{name}\b"):
         huber_update(args["x_prior"], args["P_prior"], args["z"], args["H"], args["R"], **options)
+
+
+def test_measurement_space_equals_the_whole_regression_solver():
+    # Independent computation: hinfnav.estimators.huber_regression.minimise on the whole whitened
+    # regression (n + m rows), from the same Kalman start, with explicit inverses of the Cholesky factors.
+    # Large outliers push prior rows beyond gamma, so both of huber_update's paths are taken.
+    from hinfnav.estimators.huber_regression import covariance, huber_weights, minimise, normal_matrix
+
+    rng = np.random.default_rng(7)
+    runs, n, m, gamma = 300, 6, 3, 1.0
+    A = rng.normal(size=(runs, n, n))
+    P = A @ np.swapaxes(A, -1, -2) + 0.1 * np.eye(n)
+    H = rng.normal(size=(m, n))
+    R = np.diag([1.0, 2.0, 0.5])
+    x_prior = rng.normal(size=(runs, n))
+    z = rng.normal(size=(runs, m)) * rng.choice([0.5, 3.0, 30.0], size=(runs, 1))
+    out = huber_update(x_prior, P, z, H, R, gamma=gamma)
+
+    LRi = np.linalg.inv(np.linalg.cholesky(R))
+    LPi = np.linalg.inv(np.linalg.cholesky(P))
+    M = np.concatenate([np.broadcast_to(LRi @ H, (runs, m, n)), LPi], axis=1)
+    y = np.concatenate([z @ LRi.T, (LPi @ x_prior[..., None])[..., 0]], axis=1)
+    K = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
+    x0 = x_prior + ((z - x_prior @ H.T)[:, None, :] @ np.swapaxes(K, -1, -2))[:, 0]
+    x, _, conv = minimise(M, y, x0, gamma, 1e-12, 200)
+    w = huber_weights((M @ x[..., None])[..., 0] - y, gamma)
+    assert conv.all() and out.converged.all()
+    prior_out = np.mean(np.any(out.weights[:, m:] < 1, axis=1))
+    assert 0.05 < prior_out < 0.95  # runs on both paths (measurement space; whole regression)
+    # the same unique minimiser, to the solvers' tolerance (whitened residual steps of 1e-10)
+    np.testing.assert_allclose(out.x, x, rtol=1e-8, atol=1e-8)
+    np.testing.assert_allclose(out.weights, w, rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(out.P, covariance(normal_matrix(M, w)), rtol=1e-7, atol=1e-10)

@@ -7,14 +7,14 @@ campaign grid may vary; the parameters of the scenario's
 ``truth_model(**conditions)`` are its conditions (``maneuver``, ``delta``, …).
 """
 
-import importlib
 import inspect
 from dataclasses import dataclass
+from importlib import metadata
 
 from ..core.exceptions import InputError
 
 __all__ = ["register_scenario", "registered_scenarios", "scenario_entry", "build_scenario", "scenario_parameters",
-           "condition_parameters", "load_providers", "PROVIDERS"]
+           "condition_parameters", "load_providers", "providers", "PROVIDER_GROUP"]
 
 
 @dataclass(frozen=True)
@@ -52,19 +52,26 @@ def registered_scenarios():
     return tuple(_SCENARIOS)
 
 
-#: Packages that register scenarios and estimators when imported; loaded (once) on the first unknown name,
-#: as a plugin host loads its plugins — the campaign layer never imports them statically (they sit above it).
-PROVIDERS = ("hinfnav.papers",)
+#: Entry-point group of the modules that register scenarios and estimators when imported. This
+#: package declares its papers (``hinfnav.papers``) in ``pyproject.toml``; another installed package
+#: may declare its own. They are loaded on the first unknown name, as a plugin host loads its plugins:
+#: the campaign layer never imports them by name (they sit above it).
+PROVIDER_GROUP = "hinfnav.providers"
+
+
+def providers():
+    """The provider modules declared under :data:`PROVIDER_GROUP` by the installed packages."""
+    return tuple(ep.value for ep in metadata.entry_points(group=PROVIDER_GROUP))
 
 
 def load_providers():
-    """Import :data:`PROVIDERS` (registering their scenarios and estimators); return the modules that failed."""
+    """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
     failed = {}
-    for module in PROVIDERS:
+    for ep in metadata.entry_points(group=PROVIDER_GROUP):
         try:
-            importlib.import_module(module)
+            ep.load()
         except ImportError as exc:  # pragma: no cover - a provider under construction
-            failed[module] = str(exc)
+            failed[ep.value] = str(exc)
     return failed
 
 
@@ -73,7 +80,8 @@ def scenario_entry(name, field="scenario"):
     if name not in _SCENARIOS:
         load_providers()
     if name not in _SCENARIOS:
-        known = ", ".join(_SCENARIOS) or "none (import the paper that registers it, e.g. hinfnav.papers)"
+        known = ", ".join(_SCENARIOS) or ("none (no installed package declares a provider under the entry-point "
+                                          f"group {PROVIDER_GROUP!r}; import the module that registers it)")
         raise InputError(f"{field}: unknown scenario {name!r}; registered: {known}")
     return _SCENARIOS[name]
 

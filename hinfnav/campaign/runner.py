@@ -178,6 +178,22 @@ def run_unit(unit):
     return out
 
 
+class CellResults(tuple):
+    """The cell results kept in a table's ``attrs["cells"]``: a tuple that is not copied with the table.
+
+    pandas deep-copies ``attrs`` whenever it makes a new frame from the table
+    (a selection, a row of ``itertuples``…); with hundreds of cells that
+    made a 20 000-row table take minutes to iterate. The results are
+    read-only records, so a copy is the same object.
+    """
+
+    def __deepcopy__(self, memo):
+        return self
+
+    def __copy__(self):
+        return self
+
+
 def _clean(obj):
     """JSON-ready, with NaN and inf as null (strict JSON)."""
     obj = to_json(obj)
@@ -344,7 +360,7 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
         table.to_csv(tmp, index=False)
         os.replace(tmp, out / "results.csv")
     table.attrs.update(campaign=campaign.as_dict(), computed=computed, reused=reused, errors=errors,
-                       cells=ordered, out_dir=None if out is None else str(out))
+                       cells=CellResults(ordered), out_dir=None if out is None else str(out))
     return table
 
 
@@ -384,6 +400,6 @@ def read_campaign(out_dir):
         found = _read_cell(out / "cells" / f"{cid}.json", cid)
         (cells.append(found) if found is not None else missing.append(cid))
     table = results_table(cells)
-    table.attrs.update(campaign=meta["spec"], cells=cells, missing=missing, out_dir=str(out))
+    table.attrs.update(campaign=meta["spec"], cells=CellResults(cells), missing=missing, out_dir=str(out))
     return table
 

@@ -36,6 +36,7 @@ passed κ uses the steps available.
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.linalg import matmul_shared
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
 
 __all__ = [
@@ -100,7 +101,7 @@ def fading_factors(V0, H, PhiPPhiT, Qd, R, *, beta, a):
     HT = np.swapaxes(H, -1, -2)
     N = V0 - _column(beta, 3) * R - H @ Qd @ HT
     trN = np.trace(N, axis1=-2, axis2=-1)
-    Mdiag = np.sum((PhiPPhiT @ HT) * HT, axis=-1)  # diag(Φ P Φᵀ Hᵀ H)
+    Mdiag = np.sum(matmul_shared(PhiPPhiT, HT) * HT, axis=-1)  # diag(Φ P Φᵀ Hᵀ H)
     den = np.sum(a * Mdiag, axis=-1)
     c = trN / np.where(den > 0, den, np.inf)
     lam = np.maximum(1.0, a * np.atleast_1d(c)[..., None])
@@ -232,7 +233,7 @@ class RateAdaptive:
         extra = state.extra
         kappa = input_rate(extra["rate_window"], extra["rate_count"], self.window, self.dt)
         q = rate_adapted_density(self._Q0_diag, kappa, self.epsilon, self.floor)
-        Qd = self.base_noise + self.dt * np.einsum("ia,ra,ja->rij", self.E, q, self.E)
+        Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
         return Qd, {"q_used": q, "kappa_used": kappa}
 
     def start(self, xhat0, P0=None, runs=1):

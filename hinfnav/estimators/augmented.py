@@ -28,7 +28,7 @@ its covariance is shared by every run.
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance
+from ..core.linalg import as_covariance, congruence, inv_spd, matmul_shared
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
 from .base import (
@@ -53,15 +53,15 @@ def joseph_update(P, H, R, innovation):
     ``H`` (m, n) or (runs, m, n).
     """
     HT = np.swapaxes(H, -1, -2)
-    PHT = P @ HT
-    S = H @ PHT + R
-    K = np.swapaxes(np.linalg.solve(S, np.swapaxes(PHT, -1, -2)), -1, -2)
+    PHT = matmul_shared(P, HT)
+    S = H @ PHT + R if PHT.ndim == 2 else matmul_shared(np.swapaxes(PHT, -1, -2), HT) + R  # H P Hᵀ + R (P symmetric)
+    K = PHT @ inv_spd(S)
     if K.ndim == 2:
         dx = innovation @ K.T
     else:
-        dx = np.einsum("rij,rj->ri", K, innovation)
-    I_KH = np.eye(P.shape[-1]) - K @ H
-    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
+        dx = (K @ innovation[..., None])[..., 0]
+    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
+    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
     return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
 
 
@@ -244,7 +244,7 @@ class AugmentedEKF(Estimator):
         Qd, e_noise = self.process_noise(state)
         Phi = self.transition(state.x, u)
         x = self.propagate_mean(state.x, u)
-        PhiPPhiT = Phi @ state.P @ np.swapaxes(Phi, -1, -2)
+        PhiPPhiT = congruence(Phi, state.P)
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
         return FilterState(x=x, P=PhiPPhiT + Qd, k=state.k + 1, extra=extra)

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..analysis.truncated import truncated_normal_moments
 from ..core.exceptions import InputError
-from ..core.linalg import as_covariance
+from ..core.linalg import as_covariance, inv_spd
 from ..core.validation import as_choice, as_matrix, as_positive, as_vector
 from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement, Saturated
@@ -149,7 +149,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run)."""
         H = self.measurement.H
         PHT = P_prior @ H.T
-        K = PHT @ np.linalg.inv(H @ PHT + self.R)
+        K = PHT @ inv_spd(H @ PHT + self.R)
         I_KH = self._I - K @ H
         P_post = I_KH @ P_prior @ np.swapaxes(I_KH, -1, -2) + K @ self.R @ np.swapaxes(K, -1, -2)
         return K, P_post

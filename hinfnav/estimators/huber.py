@@ -20,21 +20,27 @@ squares (IRLS) with weights ``psi = min(1, gamma / |zeta|)``, starting from
 the Kalman (OLS) solution. The reported covariance is
 ``P = (M^T Psi M)^{-1}`` at the final weights.
 
-Plain IRLS converges only linearly (hundreds of steps when several whitened
-residuals are large), so each iteration first tries the Newton point of the
-piecewise-quadratic cost for the current split of the rows into those within
-and beyond ``gamma``; if it reproduces that split it is the exact minimiser
-and the iteration ends. Otherwise the iteration keeps the cheapest of the
-IRLS step and backtracked (damped) Newton steps: the cost falls at least as
-much as under IRLS and the limit is the same Huber minimiser.
+The minimisation (:mod:`hinfnav.estimators.huber_regression`) starts from
+the Kalman solution; each iteration takes the Newton point of the current
+split of the rows into those within and beyond ``gamma`` where it is
+verified exact, else the cheapest of the IRLS step and backtracked Newton
+steps.
 
-Speed. A run whose least-squares (Kalman) residuals all lie within
-``gamma`` is finished after the least-squares solve. The weighted
-least-squares problems are solved by their normal equations, scaled to a
-unit diagonal (Jacobi) before an LU solve: for these small, well-posed
-systems (the whitened prior rows make ``M`` of full column rank) this loses
-nothing measurable against QR (the tests compare with the Kalman formula to
-1e-12 and with cvxpy to 1e-8) and is about ten times faster batched.
+Speed: the measurement space. While every whitened prior row stays within
+``gamma`` (prior weight 1), every weighted least-squares solution is
+``x = x^- + P^- A^T c`` with ``A = L_R^{-1} H`` and an m-vector ``c``
+(matrix inversion lemma): with ``C = A P^- A^T`` the whitened residuals are
+``zeta = [C c - e; L_P^T A^T c]`` (``e = L_R^{-1}(z - H x^-)``), a solve
+with weights ``d`` on the measurement rows is
+``c = b - E T^{-1} E C b`` (``E = diag(sqrt(d))``, ``T = I + E C E``, m x m),
+and ``P = P^- - P^- A^T E T^{-1} E A P^-``. The iterations are then those of
+the whole regression, done in m dimensions (3 for a position fix, against the
+n + m rows of the regression); a run whose Kalman residuals all lie within
+``gamma`` is finished after the Kalman update (its prior rows are checked by
+``||L_P^{-1} dx||_2^2 = c^T C c <= gamma^2`` before any factorisation of P).
+A run where a prior row leaves the quadratic zone is handed to the solver on
+the whole regression. Both give the same minimiser (tested against cvxpy to
+1e-8 and against the whole-regression solver).
 """
 
 from dataclasses import dataclass
@@ -42,9 +48,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.linalg import inv_spd, matmul_shared
 from ..core.validation import as_int_at_least, as_positive
+from .huber_regression import (
+    BACKTRACK,
+    BETAS,
+    covariance,
+    huber_cost,
+    huber_weights,
+    minimise,
+    mv,
+    normal_matrix,
+)
 
-__all__ = ["HuberUpdate", "huber_update"]
+__all__ = ["HuberUpdate", "huber_correct", "huber_update", "whitening"]
 
 
 @dataclass(frozen=True)
@@ -106,215 +123,6 @@ def _cholesky(name, C):
         return np.linalg.cholesky(C)
     except np.linalg.LinAlgError:
         raise InputError(f"{name} must be positive definite; its Cholesky factorisation fails") from None
-
-
-def _chol(A, pivot_tol=1e-12):
-    """Cholesky factors of a batch of symmetric matrices; ``(L, ok)``.
-
-    LAPACK factors the whole batch at once; if one matrix is not positive
-    definite (LAPACK then fails for the batch) the factors are computed by
-    columns vectorised over the batch, and ``ok`` is False for a run whose
-    pivot falls to ``pivot_tol`` times its largest diagonal entry or below
-    (singular or indefinite to working precision; its factor is meaningless).
-    """
-    try:
-        return np.linalg.cholesky(A), np.ones(A.shape[0], dtype=bool)
-    except np.linalg.LinAlgError:
-        pass
-    n = A.shape[-1]
-    L = np.zeros_like(A)
-    floor = pivot_tol * np.max(np.abs(np.diagonal(A, axis1=-2, axis2=-1)), axis=-1)
-    ok = np.isfinite(floor)
-    for j in range(n):
-        lj = L[:, j, :j]
-        d = A[:, j, j] - np.sum(lj * lj, axis=-1)
-        good = d > floor
-        ok &= good
-        piv = np.sqrt(np.where(good, d, 1.0))
-        L[:, j, j] = piv
-        if j + 1 < n:
-            L[:, j + 1:, j] = (A[:, j + 1:, j] - (L[:, j + 1:, :j] @ lj[:, :, None])[..., 0]) / piv[:, None]
-    return L, ok
-
-
-#: Below this many runs one LAPACK call per matrix is cheaper than the column loops.
-_SMALL_BATCH = 48
-
-
-def _tri_solve(L, b, lower=True):
-    """``L^{-1} b`` (or ``L^{-T} b`` with ``lower=False``) for a batch of lower-triangular ``L``."""
-    if L.shape[0] < _SMALL_BATCH:
-        return np.linalg.solve(L if lower else np.swapaxes(L, -1, -2), b[..., None])[..., 0]
-    n = L.shape[-1]
-    x = np.zeros(np.broadcast_shapes(L.shape[:-1], b.shape))
-    for i in range(n) if lower else reversed(range(n)):
-        if lower:
-            acc = np.sum(L[:, i, :i] * x[:, :i], axis=-1)
-        else:
-            acc = np.sum(L[:, i + 1:, i] * x[:, i + 1:], axis=-1)
-        x[:, i] = (b[:, i] - acc) / L[:, i, i]
-    return x
-
-
-def _tri_inv(L):
-    """``L^{-1}`` for a batch of lower-triangular ``L`` (forward substitution on the identity)."""
-    if L.shape[0] < _SMALL_BATCH:
-        return np.linalg.inv(L)
-    n = L.shape[-1]
-    X = np.zeros_like(L)
-    for i in range(n):
-        X[:, i, :i + 1] = -(L[:, i:i + 1, :i] @ X[:, :i, :i + 1])[:, 0] / L[:, i, i, None]
-        X[:, i, i] = 1.0 / L[:, i, i]
-    return X
-
-
-def _scaled(A):
-    """Jacobi scaling ``(s, S A S)``, ``s = diag(A)^{-1/2}`` (1 where the diagonal is not positive)."""
-    d = np.diagonal(A, axis1=-2, axis2=-1)
-    good = np.isfinite(d) & (d > 0)
-    s = np.where(good, 1.0 / np.sqrt(np.where(good, d, 1.0)), 1.0)
-    return s, A * s[:, :, None] * s[:, None, :], np.all(good, axis=-1)
-
-
-def _spd_solve(A, b, usable=None):
-    """Solve ``A x = b`` for a batch of symmetric positive (semi)definite ``A``; ``(x, ok)``.
-
-    The matrices are scaled to a unit diagonal (Jacobi) and factored by
-    :func:`_chol`. ``ok`` is False where the system is singular to working
-    precision, where ``usable`` (a boolean per run, optional) is False, or
-    where the solution is not finite (``x`` is then 0 there): the caller
-    treats such runs as having no step.
-    """
-    s, As, ok = _scaled(A)
-    if usable is not None:
-        ok = ok & usable
-    As = np.where(ok[:, None, None], As, np.eye(A.shape[-1]))
-    L, good = _chol(As)
-    ok = ok & good
-    with np.errstate(all="ignore"):
-        x = s * _tri_solve(L, _tri_solve(L, s * b), lower=False)
-    ok = ok & np.all(np.isfinite(x), axis=-1)
-    return np.where(ok[:, None], x, 0.0), ok
-
-
-def _mv(M, x):
-    """``M x`` for a batch (``M`` (r, k, n), ``x`` (r, n))."""
-    return (M @ x[..., None])[..., 0]
-
-
-def _mtv(M, v):
-    """``M^T v`` for a batch (``M`` (r, k, n), ``v`` (r, k))."""
-    return (v[..., None, :] @ M)[..., 0, :]
-
-
-def _normal_matrix(M, w):
-    """``M^T diag(w) M`` for a batch."""
-    return np.swapaxes(M * w[..., :, None], -1, -2) @ M
-
-
-def _weighted_ls(M, y, w):
-    """Solve ``min sum_i w_i (M_i x - y_i)^2`` for a batch (weights > 0, M of full column rank).
-
-    Returns the solution and the normal matrix ``M^T diag(w) M``.
-    """
-    A = _normal_matrix(M, w)
-    x, _ = _spd_solve(A, _mtv(M, w * y))
-    return x, A
-
-
-def _covariance(A):
-    """``A^{-1}`` of a batch of symmetric positive definite matrices (by the scaled Cholesky factor), symmetric."""
-    s, As, _ = _scaled(A)
-    Li = _tri_inv(_chol(As)[0])
-    P = (np.swapaxes(Li, -1, -2) @ Li) * s[:, :, None] * s[:, None, :]
-    return 0.5 * (P + np.swapaxes(P, -1, -2))
-
-
-def _newton_steps(M, y, x, zeta, gamma, betas=None):
-    """Newton-type candidates for the Huber cost at ``x``, and whether the first is exact.
-
-    The cost is piecewise quadratic: with ``Q`` the rows where
-    ``|zeta| <= gamma``, its gradient is ``g = M^T rho'(zeta)`` and its Hessian
-    ``M_Q^T M_Q``. The Newton point ``x - (M_Q^T M_Q)^{-1} g`` solves the
-    stationarity condition for this classification; if it reproduces the
-    classification it is the minimiser (global, by convexity). When
-    ``M_Q`` has too few rows the Hessian is singular, so further candidates
-    give the linear rows a small curvature ``beta * psi`` (``beta`` in
-    ``_BETAS``, or ``betas`` when given, which must start with 0); ``beta = 1``
-    would be the IRLS step.
-    """
-    n = M.shape[-1]
-    quad = np.abs(zeta) <= gamma
-    sign = np.sign(zeta)
-    grad = _mtv(M, np.where(quad, zeta, gamma * sign))
-    psi = _huber_weights(zeta, gamma)
-    cands, exact = [], None
-    for beta in _BETAS if betas is None else betas:
-        d = np.where(quad, 1.0, beta * psi)
-        # singular runs (too few rows within gamma): no step, rejected by cost or flag
-        dx, ok = _spd_solve(_normal_matrix(M, d), grad, usable=(quad.sum(axis=-1) >= n) if beta == 0.0 else None)
-        cands.append(x - dx)
-        if beta == 0.0:
-            zc = _mv(M, x - dx) - y
-            slack = 1e-12 * gamma
-            same = np.where(quad, np.abs(zc) <= gamma + slack, sign * zc >= gamma - slack).all(axis=-1)
-            exact = ok & same
-    return np.stack(cands, axis=1), exact
-
-
-_BETAS = (0.0, 1e-1, 1e-2, 1e-3)
-_BACKTRACK = 0.5 ** np.arange(11)
-
-
-def _huber_cost(zeta, gamma):
-    a = np.abs(zeta)
-    return np.sum(np.where(a <= gamma, 0.5 * a * a, gamma * a - 0.5 * gamma * gamma), axis=-1)
-
-
-def _huber_weights(zeta, gamma):
-    a = np.abs(zeta)
-    return np.where(a <= gamma, 1.0, gamma / np.maximum(a, gamma))
-
-
-def _minimise(M, y, x, gamma, tol, max_iter):
-    """Minimise ``sum rho_gamma(M x - y)`` from ``x`` for a batch; ``(x, iterations, converged)``.
-
-    Each iteration takes the Newton point of the current split of the rows
-    (within / beyond gamma) where it is verified exact, else the cheapest of
-    the IRLS step and backtracked (damped) Newton steps.
-    """
-    runs, n = x.shape
-    x = x.copy()
-    iterations = np.zeros(runs, dtype=int)
-    converged = np.zeros(runs, dtype=bool)
-    for _ in range(max_iter):
-        act = np.flatnonzero(~converged)
-        if act.size == 0:
-            break
-        Ma, ya, xa = M[act], y[act], x[act]
-        zeta = _mv(Ma, xa) - ya
-        # The Newton point of the current classification; where it is verified
-        # exact it is the minimiser and nothing else is needed.
-        x0c, exact = _newton_steps(Ma, ya, xa, zeta, gamma, betas=(0.0,))
-        x_next = x0c[:, 0].copy()
-        step = np.zeros(act.size)
-        rest = np.flatnonzero(~exact)
-        if rest.size:
-            Mr, yr, xr, zr = Ma[rest], ya[rest], xa[rest], zeta[rest]
-            xn, _ = _weighted_ls(Mr, yr, _huber_weights(zr, gamma))  # IRLS step
-            step[rest] = np.max(np.abs(_mv(Mr, xn - xr)), axis=1)
-            # Newton steps of the piecewise-quadratic cost, backtracked; keep the
-            # cheapest of them and the IRLS step, so the cost decreases at least
-            # as much as under plain IRLS.
-            xc, _ = _newton_steps(Mr, yr, xr, zr, gamma)
-            dirs = (xc - xr[:, None])[:, :, None] * _BACKTRACK[None, None, :, None]
-            trial = np.concatenate([xn[:, None], xr[:, None] + dirs.reshape(rest.size, -1, n)], axis=1)
-            cost = _huber_cost((trial @ np.swapaxes(Mr, -1, -2)) - yr[:, None], gamma)
-            x_next[rest] = trial[np.arange(rest.size), np.argmin(cost, axis=1)]
-        x[act] = x_next
-        iterations[act] += 1
-        converged[act] = exact | (step <= tol)
-    return x, iterations, converged
 
 
 def huber_update(x_prior, P_prior, z, H, R, *, gamma=1.345, tol=1e-10, max_iter=50):
@@ -401,39 +209,188 @@ def huber_update(x_prior, P_prior, z, H, R, *, gamma=1.345, tol=1e-10, max_iter=
     def full(arr, core):
         return np.broadcast_to(arr, (nr,) + arr.shape[arr.ndim - core:])
 
-    L_R = full(_cholesky("R", R), 2)
-    L_P = full(_cholesky("P_prior", P_prior), 2)
-    x0, zz, HH, PP, RR = full(x_prior, 1), full(z, 1), full(H, 2), full(P_prior, 2), full(R, 2)
-
-    # Least squares on the whole regression is the Kalman update; it is computed
-    # in its usual form (an m x m solve), with the Joseph-form covariance.
-    PHt = PP @ np.swapaxes(HH, -1, -2)
-    K = np.swapaxes(np.linalg.solve(HH @ PHt + RR, np.swapaxes(PHt, -1, -2)), -1, -2)
-    x = x0 + _mv(K, zz - _mv(HH, x0))
-    # Its whitened residuals, M x - y = [L_R^{-1}(H x - z); L_P^{-1}(x - x_prior)]. A run
-    # whose residuals all lie within gamma is already the minimiser (there the Huber
-    # cost is the least-squares cost): its first iteration would only verify that.
-    zeta = np.concatenate([_tri_solve(L_R, _mv(HH, x) - zz), _tri_solve(L_P, x - x0)], axis=1)
-    inside = np.all(np.abs(zeta) <= gamma, axis=-1)
-    iterations = np.ones(nr, dtype=int)
-    converged = inside.copy()
-    w = np.ones((nr, m + n))
-    I_KH = np.eye(n) - K @ HH
-    P = I_KH @ PP @ np.swapaxes(I_KH, -1, -2) + K @ RR @ np.swapaxes(K, -1, -2)
-    P = 0.5 * (P + np.swapaxes(P, -1, -2))
-
-    out = np.flatnonzero(~inside)
-    if out.size:
-        # Whitened regression of those runs: M = S^{-1} [H; I], y = S^{-1} [z; x_prior].
-        LRi = _tri_inv(np.ascontiguousarray(L_R[out]))
-        LPi = _tri_inv(np.ascontiguousarray(L_P[out]))
-        M = np.concatenate([LRi @ HH[out], LPi], axis=1)
-        y = np.concatenate([_mv(LRi, zz[out]), _mv(LPi, x0[out])], axis=1)
-        xs, its, conv = _minimise(M, y, x[out], gamma, tol, max_iter)
-        x[out], iterations[out], converged[out] = xs, its, conv
-        w[out] = _huber_weights(_mv(M, xs) - y, gamma)
-        P[out] = _covariance(_normal_matrix(M, w[out]))
-
+    _cholesky("R", R)
+    _cholesky("P_prior", P_prior)
+    x, P, w, iterations, converged = huber_correct(full(x_prior, 1), full(P_prior, 2), full(z, 1), H, R,
+                                                   gamma=gamma, tol=tol, max_iter=max_iter)
     if batched:
         return HuberUpdate(x=x, P=P, weights=w, iterations=iterations, converged=converged)
     return HuberUpdate(x=x[0], P=P[0], weights=w[0], iterations=int(iterations[0]), converged=bool(converged[0]))
+
+
+def _swap(M):
+    return np.swapaxes(M, -1, -2)
+
+
+def _weighted(C, b, d):
+    """``c`` of the weighted solve ``(P^{-1} + A^T D A)^{-1} A^T b = P A^T c``: ``b - E T^{-1} E C b``.
+
+    ``E = diag(sqrt(d))``, ``T = I + E C E``; batched over any leading axes
+    (C (..., m, m), b and d (..., m)); T ≥ I, so the inverse always exists.
+    """
+    E = np.sqrt(d)
+    T = E[..., :, None] * C * E[..., None, :] + np.eye(C.shape[-1])
+    return b - E * mv(inv_spd(T), E * mv(C, b))
+
+
+def _residuals(C, e, B, c):
+    """Whitened residuals ``(C c - e, B c)`` of the measurement and prior rows at ``c`` (any leading axes)."""
+    return (C @ c[..., None])[..., 0] - e, (B @ c[..., None])[..., 0]
+
+
+def _minimise_measurement_space(C, e, B, c, gamma, tol, max_iter):
+    """The iterations of :func:`huber_regression.minimise` in the measurement space.
+
+    The Newton point is that of the current split of the measurement rows
+    with every prior row quadratic (the prior rows are within gamma at the
+    minimiser of almost every update, even when the Kalman correction of an
+    outlier takes them beyond it); where it reproduces that split and keeps
+    the prior rows within gamma it satisfies the optimality conditions of the
+    convex cost, hence is the minimiser. Otherwise the IRLS and damped Newton
+    steps of the whole-regression solver are taken, in m dimensions, while
+    the prior rows are within gamma at the current point.
+
+    Returns ``(c, iterations, converged, left)``; ``left`` marks the runs
+    stopped at a point with a prior row beyond gamma whose Newton point was
+    not exact (their ``c`` is that point; the caller finishes them on the
+    whole regression).
+    """
+    runs, m = c.shape
+    c = c.copy()
+    iterations = np.zeros(runs, dtype=int)
+    converged = np.zeros(runs, dtype=bool)
+    left = np.zeros(runs, dtype=bool)
+    slack = 1e-12 * gamma
+    for _ in range(max_iter):
+        act = np.flatnonzero(~(converged | left))
+        if act.size == 0:
+            break
+        Ca, ea, Ba, ca = C[act], e[act], B[act], c[act]
+        zm, zp = _residuals(Ca, ea, Ba, ca)
+        quad = np.abs(zm) <= gamma
+        sign = np.sign(zm)
+        grad = ca + np.where(quad, zm, gamma * sign)  # A^T grad is the gradient (prior rows quadratic)
+        psi = huber_weights(zm, gamma)
+        # Newton points for weights 1 (quadratic rows) and beta * psi (linear rows), beta in BETAS
+        d = np.where(quad[:, None, :], 1.0, np.asarray(BETAS)[None, :, None] * psi[:, None, :])
+        cand = ca[:, None] - _weighted(Ca[:, None], grad[:, None], d)
+        # the first (beta = 0) is the minimiser if it reproduces the split (prior rows within gamma)
+        zc, zpc = _residuals(Ca, ea, Ba, cand[:, 0])
+        exact = (np.where(quad, np.abs(zc) <= gamma + slack, sign * zc >= gamma - slack).all(axis=-1)
+                 & (np.abs(zpc) <= gamma + slack).all(axis=-1))
+        c_next = cand[:, 0].copy()
+        step = np.zeros(act.size)
+        # Not exact, and a prior row beyond gamma here: the other steps need the whole regression
+        gone = ~exact & np.any(np.abs(zp) > gamma, axis=-1)
+        left[act[gone]] = True
+        rest = np.flatnonzero(~exact & ~gone)
+        if rest.size:
+            Cr, er, Br, cr = Ca[rest], ea[rest], Ba[rest], ca[rest]
+            cI = _weighted(Cr, psi[rest] * er, psi[rest])  # IRLS step
+            dm, dp = _residuals(Cr, 0.0, Br, cI - cr)
+            step[rest] = np.maximum(np.max(np.abs(dm), axis=-1), np.max(np.abs(dp), axis=-1))
+            dirs = (cand[rest] - cr[:, None])[:, :, None] * BACKTRACK[None, None, :, None]
+            trial = np.concatenate([cI[:, None], cr[:, None] + dirs.reshape(rest.size, -1, m)], axis=1)
+            tm, tp = _residuals(Cr[:, None], er[:, None], Br[:, None], trial)
+            cost = huber_cost(tm, gamma) + huber_cost(tp, gamma)
+            c_next[rest] = trial[np.arange(rest.size), np.argmin(cost, axis=1)]
+        keep = act[~gone]
+        c[keep] = c_next[~gone]
+        iterations[keep] += 1
+        converged[keep] = (exact | (step <= tol))[~gone]
+    return c, iterations, converged, left
+
+
+def whitening(R):
+    """``L_R^{-1}`` (= ``L_Rᵀ R⁻¹``) of the lower Cholesky factor of R (m, m) or a batch (runs, m, m)."""
+    try:
+        L_R = np.linalg.cholesky(R)
+    except np.linalg.LinAlgError:
+        raise InputError("R must be positive definite; its Cholesky factorisation fails") from None
+    return _swap(L_R) @ inv_spd(R)
+
+
+def huber_correct(x_prior, P_prior, z, H, R, *, gamma, tol, max_iter, LRi=None):
+    """The Huber update of :func:`huber_update` on checked, batched inputs (no validation).
+
+    ``x_prior`` (runs, n) or None (zero: ``z`` is then the innovation),
+    ``P_prior`` (runs, n, n), ``z`` (runs, m); ``H`` (m, n) or (runs, m, n),
+    ``R`` (m, m) or (runs, m, m), both symmetric positive definite
+    covariances; ``LRi``, optionally, :func:`whitening` of a constant R
+    computed once. Returns ``(x, P, weights, iterations, converged)`` with a
+    leading runs axis. For filters, which build their inputs themselves; see
+    the module docstring for the method.
+    """
+    runs, n = P_prior.shape[0], P_prior.shape[-1]
+    m = z.shape[-1]
+    if x_prior is None:
+        x_prior = np.zeros((runs, n))
+        innovation = z
+    else:
+        innovation = z - mv(H, x_prior)
+    LRi = whitening(R) if LRi is None else LRi
+    A = LRi @ H  # whitened measurement matrix
+    e = mv(LRi, innovation)  # one matrix-vector product per run (a 2-D product would round differently for 1 run)
+    AT = _swap(A)
+    PAT = matmul_shared(P_prior, AT)
+    C = _swap(PAT) @ AT if A.ndim == 3 else matmul_shared(_swap(PAT), AT)  # A P Aᵀ = (P Aᵀ)ᵀ Aᵀ (P symmetric)
+    C = 0.5 * (C + _swap(C))
+    Si = inv_spd(C + np.eye(m))
+    c = mv(Si, e)  # the Kalman (least-squares) solution, x = x_prior + P Aᵀ c
+    zm = mv(C, c) - e
+    # prior rows: |L_P^{-1} dx| <= ||L_P^{-1} dx||_2 = sqrt(cᵀ C c); factor P only where that bound exceeds gamma
+    meas_in = np.all(np.abs(zm) <= gamma, axis=-1)
+    need = np.flatnonzero(~meas_in | (np.sum(c * mv(C, c), axis=-1) > gamma * gamma))
+    inside = meas_in.copy()
+    B = None
+    if need.size:
+        try:
+            L_P = np.linalg.cholesky(P_prior[need])
+        except np.linalg.LinAlgError:
+            raise InputError("P_prior must be positive definite; its Cholesky factorisation fails") from None
+        B = _swap(L_P) @ (AT[need] if AT.ndim == 3 else AT)  # L_Pᵀ Aᵀ: prior residuals L_P^{-1} P Aᵀ c
+        inside[need] &= np.all(np.abs(mv(B, c[need])) <= gamma, axis=-1)
+    # P = (Mᵀ M)⁻¹ = P − P Aᵀ S⁻¹ A P for every run (weights 1: the Kalman covariance; K_w = P Aᵀ S⁻¹);
+    # the runs out are overwritten below with their weights
+    Kw = PAT @ Si
+    P = P_prior - Kw @ _swap(PAT)
+    P = 0.5 * (P + _swap(P))
+    iterations = np.ones(runs, dtype=int)
+    converged = inside.copy()
+    w = np.ones((runs, m + n))
+    x = x_prior + mv(PAT, c)
+
+    out = np.flatnonzero(~inside)
+    if out.size:
+        pos = np.searchsorted(need, out)  # rows of B for the runs out
+        Co = C[out]
+        Ao = A[out] if A.ndim == 3 else A
+        co, its, conv, left = _minimise_measurement_space(Co, e[out], B[pos], c[out], gamma, tol, max_iter)
+        zm, zp = _residuals(Co, e[out], B[pos], co)
+        wo = np.concatenate([huber_weights(zm, gamma), huber_weights(zp, gamma)], axis=-1)
+        xo = x_prior[out] + mv(PAT[out], co)
+        E = np.sqrt(wo[:, :m])
+        U = PAT[out] * E[:, None, :]
+        Po = P_prior[out] - U @ inv_spd(E[:, :, None] * Co * E[:, None, :] + np.eye(m)) @ _swap(U)
+        Po = 0.5 * (Po + _swap(Po))
+        general = np.flatnonzero(left | (wo[:, m:] < 1).any(axis=-1))
+        if general.size:
+            # a prior row beyond gamma: the whole whitened regression M = [A; L_P^{-1}], y = [e; 0] in dx
+            g = out[general]
+            LPi = np.linalg.inv(np.linalg.cholesky(P_prior[g]))
+            M = np.concatenate([np.broadcast_to(Ao, (g.size, m, n)) if Ao.ndim == 2 else Ao[general], LPi], axis=1)
+            y = np.concatenate([e[g], np.zeros((g.size, n))], axis=1)
+            dx0 = mv(PAT[g], co[general])
+            remaining = max_iter - its[general]
+            its_g, conv_g = np.zeros(g.size, dtype=int), conv[general].copy()
+            dx = dx0.copy()
+            for budget in np.unique(remaining[left[general] & (remaining > 0)]):  # the iterations each run has left
+                todo = np.flatnonzero(left[general] & (remaining == budget))
+                dx[todo], its_g[todo], conv_g[todo] = minimise(M[todo], y[todo], dx0[todo], gamma, tol, int(budget))
+            its[general] += its_g
+            conv[general] = conv_g
+            wo[general] = huber_weights(mv(M, dx) - y, gamma)
+            xo[general] = x_prior[g] + dx
+            Po[general] = covariance(normal_matrix(M, wo[general]))
+        x[out], P[out], w[out], iterations[out], converged[out] = xo, Po, wo, its, conv
+    return x, P, w, iterations, converged

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive
-from .huber import huber_update
+from .huber import huber_correct, whitening
 from .kalman import ExtendedKalmanFilter
 
 __all__ = ["HuberFilter"]
@@ -67,6 +67,7 @@ class HuberFilter(ExtendedKalmanFilter):
         self.gamma = as_positive("gamma", gamma)
         self.tol = as_positive("tol", tol)
         self.max_iter = as_int_at_least("max_iter", max_iter, 1)
+        self._LRi = None if self.R is None else whitening(self.R)  # constant R: whitened once
 
     @classmethod
     def from_ekf(cls, ekf, *, gamma=1.345, tol=1e-10, max_iter=50, name=None):
@@ -88,9 +89,9 @@ class HuberFilter(ExtendedKalmanFilter):
 
     def correct(self, x, P, H, innovation, state, R=None):
         """Huber M-estimation update; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
+        LRi = self._LRi if R is None else None
         R = self.R if R is None else R
-        runs, n = x.shape
-        res = huber_update(np.zeros((runs, n)), P, innovation, H, R, gamma=self.gamma, tol=self.tol,
-                           max_iter=self.max_iter)
-        diag = {"weights": res.weights, "iterations": res.iterations, "converged": res.converged}
-        return x + res.x, res.P, diag
+        dx, P_post, weights, iterations, converged = huber_correct(
+            None, P, innovation, H, R, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter, LRi=LRi)
+        diag = {"weights": weights, "iterations": iterations, "converged": converged}
+        return x + dx, P_post, diag

@@ -24,7 +24,7 @@ The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance
+from ..core.linalg import as_covariance, congruence, inv_spd
 from ..core.validation import as_choice
 from .base import Estimator, FilterState, StepOutput
 
@@ -98,7 +98,7 @@ class ExtendedKalmanFilter(Estimator):
 
     def predict_covariance(self, P, state):
         """``Φ P Φᵀ + Q`` (P shared (n, n) or per run (runs, n, n))."""
-        return self.F @ P @ self.F.T + self.Q
+        return congruence(self.F, P) + self.Q
 
     def measurement_covariance(self, y, x):
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
@@ -119,7 +119,7 @@ class ExtendedKalmanFilter(Estimator):
         HT = np.swapaxes(H, -1, -2)
         PHT = P @ HT
         S = H @ PHT + R
-        K = PHT @ np.linalg.inv(S)
+        K = PHT @ inv_spd(S)
         if K.ndim == 2:
             x_post = x + innovation @ K.T
         else:

@@ -3,16 +3,15 @@
 import time
 from pathlib import Path
 
-import pandas as pd
 from tqdm import tqdm
 
-from ...campaign.runner import campaign_client, run_campaign
+from ...campaign.runner import run_campaign
 from ...core.exceptions import InputError
 from ...core.outputs import write_json
 from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...plotting.save import save_figure
-from .grid import DELTAS, NOISES, REDUCED, REDUCED_GRID, TOL, WINDOWS, benchmark_campaign, fit_matrix, load_papers
+from .grid import DELTAS, NOISES, TOL, WINDOWS, benchmark_campaign, fit_matrix, load_papers
 from .table import benchmark_table, best_by_condition, format_markdown, plot_heatmap
 
 __all__ = ["reproduce"]
@@ -35,20 +34,15 @@ def _execute_notebooks(out_dir, timeout=900):
         nbformat.write(nb, Path(out_dir) / path.name)
 
 
-def _note(full, runs, costly):
+def _note(runs):
     parts = [f"{runs} Monte Carlo runs per cell (seeds from the cell, common to every estimator of a cell)."]
     if runs < BENCHMARK_RUNS:
         parts.append(f"**Quick look**: the benchmark proper has at least {BENCHMARK_RUNS} runs per cell.")
-    if costly and not full:
-        grid = ", ".join(f"{k} ∈ {{{', '.join(map(str, v))}}}" for k, v in REDUCED_GRID.items())
-        parts.append(f"{', '.join(f'`{n}`' for n in costly)} carry a covariance per run and cost 20–60 times more; "
-                     f"to stay under 10 minutes on 2 cores they run on {grid} only (`reproduce(full=True)` runs "
-                     "them everywhere).")
     return " ".join(parts)
 
 
 def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, notebooks=False, progress=True,
-              full=False, client=None, campaign_dir=None, estimators=None):
+              client=None, campaign_dir=None, estimators=None):
     """Run the cross-paper benchmark and write its table, heat map and summary into ``out_dir``.
 
     Parameters
@@ -60,8 +54,6 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     notebooks : bool
         Also execute the notebooks into ``out_dir``.
     progress : bool
-    full : bool
-        Run the costly estimators (:data:`~hinfnav.papers.benchmark.grid.REDUCED`) on every cell as well.
     client : None, "serial", str or distributed.Client
         Where the campaign runs (:func:`hinfnav.run_campaign`); default a LocalCluster on this machine's cores.
     campaign_dir : str or Path, optional
@@ -84,23 +76,19 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     for key, err in papers.items():
         if err is not None and progress:
             tqdm.write(f"paper {key} could not be imported, its estimators are left out: {err}")
-    campaigns = benchmark_campaign(runs=runs, seed=seed, full=full, estimators=estimators)
+    campaign = benchmark_campaign(runs=runs, seed=seed, estimators=estimators)
     cdir = Path(campaign_dir) if campaign_dir is not None else out / "campaign"
-    with campaign_client(client) as dask_client:  # one cluster for both campaigns
-        tables = [run_campaign(camp, client=dask_client, out_dir=cdir / camp.name, progress=progress)
-                  for camp in campaigns]
-    results = pd.concat(tables, ignore_index=True)
-    errors = {k: v for t in tables for k, v in t.attrs["errors"].items()}
+    results = run_campaign(campaign, client=client, out_dir=cdir / campaign.name, progress=progress)
+    errors = dict(results.attrs["errors"])
     table = benchmark_table(results)
     names = list(dict.fromkeys(table["estimator"]))
-    costly = [n for n in names if n in REDUCED]
-    prov = provenance(seed=seed, runs=runs, paper="benchmark", full=full)
-    note = _note(full, runs, costly)
+    prov = provenance(seed=seed, runs=runs, paper="benchmark")
+    note = _note(runs)
     table.to_csv(out / "table.csv", index=False)
     (out / "table.md").write_text(format_markdown(table, note=note))
     save_figure(plot_heatmap(table), out, "heatmap", prov)
     cells = [{**c["params"], "cell_id": c["cell_id"], "seed": c["seed"], "runs": c["runs"], "status": c["status"],
-              "statistics": c["statistics"], "timing": c["timing"]} for t in tables for c in t.attrs["cells"]]
+              "statistics": c["statistics"], "timing": c["timing"]} for c in results.attrs["cells"]]
     ratios = table.to_dict(orient="records")
     limits = {f"maneuver={m} delta={d:g}": {"pos_m": p, "vel_mps": v, "pos_m_predicted": pp, "vel_mps_predicted": vp}
               for m, d, p, v, pp, vp in table[["maneuver", "delta", "kalman_pos_m", "kalman_vel_mps",
@@ -111,8 +99,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
         "title": "Cross-paper benchmark on Sun et al. (2011)'s chaser (issue 13)",
         "note": note,
         "grid": {"maneuver": [True, False], "delta": list(DELTAS), "noise": list(NOISES), "windows_s": WINDOWS,
-                 "tol": list(TOL), "reduced": {"estimators": costly, "grid": REDUCED_GRID} if costly and not full
-                 else None},
+                 "tol": list(TOL)},
         "estimators": names,
         "cells": cells,
         "table": ratios,
