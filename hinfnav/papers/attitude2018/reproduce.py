@@ -156,5 +156,5 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
         if ch is not None:
             print("\nSun 2011's chaser, control law unknown (mean of per-run RMS over axes, 95 % interval):")
             print(format_chaser_table(ch))
-        print(f"\nwrote {out.resolve()} in {time.perf_counter() - t0:.0f} s")
+        print(f"\npaper 002 (attitude): done in {time.perf_counter() - t0:.0f} s")
     return summary

@@ -360,5 +360,5 @@ def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, p
         print(format_table(summary))
         for case, v in summary["verdicts"].items():
             print(f"{case}: {'reproduced' if v['reproduced'] else 'NOT reproduced'} — {v['text']}")
-        print(f"\nwrote {out.resolve()} in {time.perf_counter() - t0:.0f} s")
+        print(f"\nShi & Wang 2018: done in {time.perf_counter() - t0:.0f} s")
     return summary

@@ -253,7 +253,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     if notebooks:
         execute_notebooks(out)
     if progress:
-        print(f"\nYang et al. 2020: wrote {out.resolve()} in {timings['total_s']:.0f} s")
+        print(f"\nYang et al. 2020: done in {timings['total_s']:.0f} s")
         for c in summary["claims"]:
             print(f"  [{c['verdict']}] {c['figure']}: {c['claim']}")
     return summary
