@@ -25,7 +25,6 @@ import contextlib
 import importlib
 import json
 import logging
-import math
 import os
 import time
 from pathlib import Path
@@ -196,14 +195,7 @@ class CellResults(tuple):
 
 def _clean(obj):
     """JSON-ready, with NaN and inf as null (strict JSON)."""
-    obj = to_json(obj)
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_clean(v) for v in obj]
-    return obj
+    return to_json(obj, strict=True)
 
 
 def _atomic_write(path, text):

@@ -13,6 +13,7 @@ removes); no file ever mixes two runs.
 import contextlib
 import errno
 import json
+import math
 import os
 import shutil
 from pathlib import Path
@@ -119,16 +120,22 @@ def atomic_output_dir(path, *, keep=(), name="out"):
         lock.unlink(missing_ok=True)
 
 
-def to_json(obj):
-    """A JSON-ready copy of ``obj``: numpy arrays and scalars become lists and Python numbers."""
+def to_json(obj, *, strict=False):
+    """A JSON-ready copy of ``obj``: numpy arrays and scalars become lists and Python numbers.
+
+    ``strict=True`` also turns NaN and infinities into None (null), which
+    strict JSON requires (Python's ``json`` writes them as ``NaN``/``Infinity``).
+    """
     if isinstance(obj, dict):
-        return {str(k): to_json(v) for k, v in obj.items()}
+        return {str(k): to_json(v, strict=strict) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [to_json(v) for v in obj]
+        return [to_json(v, strict=strict) for v in obj]
     if isinstance(obj, np.ndarray):
-        return to_json(obj.tolist())
+        return to_json(obj.tolist(), strict=strict)
     if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return obj.item()
+        obj = obj.item()
+    if strict and isinstance(obj, float) and not math.isfinite(obj):
+        return None
     return obj
 
 

@@ -1,17 +1,15 @@
 """``python -m hinfnav reproduce --paper attitude2018``: paper 002's Figs 1–9, its claims measured, the chaser study."""
 
 import json
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
-from ...core.exceptions import InputError
 from ...core.outputs import to_json
 from ...core.validation import as_int_at_least
+from ..notebooks import run_notebooks
 from .chaser import chaser_study, format_chaser_table, plot_chaser
 from .claims import format_claims, measure_claims
 from .constants import CITATION, PAPER_OMEGA_E_DEG_S, orbit_rate
@@ -93,13 +91,7 @@ def _save(fig, out_dir, name):
 
 
 def _execute_notebooks(out_dir):
-    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
-    paths = sorted(nb_dir.glob(NOTEBOOKS))
-    if not paths:
-        raise InputError(f"notebooks=True needs the repository's notebooks/ folder; no {NOTEBOOKS} in {nb_dir}")
-    cmd = [sys.executable, "-m", "nbconvert", "--to", "notebook", "--execute", "--output-dir", str(out_dir)]
-    subprocess.run(cmd + [str(p) for p in paths], check=True, cwd=nb_dir)
-    return [Path(out_dir) / p.name for p in paths]
+    return run_notebooks(out_dir, NOTEBOOKS)
 
 
 def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=False, progress=True, scenario=None,

@@ -11,6 +11,7 @@ from ...core.outputs import write_json
 from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...plotting.save import save_figure
+from ..notebooks import run_notebooks
 from .grid import DELTAS, NOISES, TOL, WINDOWS, benchmark_campaign, fit_matrix, load_papers
 from .table import benchmark_table, best_by_condition, format_markdown, plot_heatmap
 
@@ -22,16 +23,7 @@ BENCHMARK_RUNS = 200
 
 def _execute_notebooks(out_dir, timeout=900):
     """Execute the comparison decade's notebooks (``notebooks/9N_*.ipynb``) into ``out_dir``."""
-    import nbformat  # heavy optional libraries: only with notebooks=True
-    from nbclient import NotebookClient
-
-    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
-    if not nb_dir.is_dir():
-        raise InputError(f"notebooks=True needs the repository's notebooks/ folder next to the package; not found at {nb_dir}")
-    for path in sorted(nb_dir.glob("9[0-9]_*.ipynb")):
-        nb = nbformat.read(path, as_version=4)
-        NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(nb_dir)}}).execute()
-        nbformat.write(nb, Path(out_dir) / path.name)
+    return run_notebooks(out_dir, "9[0-9]_*.ipynb", timeout=timeout)
 
 
 def _note(runs):

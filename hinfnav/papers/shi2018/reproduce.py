@@ -22,6 +22,7 @@ from tqdm import tqdm
 from ...core.exceptions import InputError
 from ...core.progress import bar_disabled
 from ...core.validation import as_int_at_least
+from ..notebooks import run_notebooks
 from .calibration import riccati_accuracy
 from .constants import (
     CALIBRATION_TARGET,
@@ -295,20 +296,7 @@ def _save(fig, out_dir, name):
 
 def execute_notebooks(out_dir, timeout=900):
     """Execute this paper's notebooks (``notebooks/1[0-9]_*.ipynb``) into ``out_dir``."""
-    import nbformat
-    from nbclient import NotebookClient
-
-    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
-    if not nb_dir.is_dir():
-        raise InputError(f"notebooks=True needs the repository's notebooks/ folder; not found at {nb_dir}")
-    written = []
-    for path in sorted(nb_dir.glob("1[0-9]_*.ipynb")):
-        nb = nbformat.read(path, as_version=4)
-        client = NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(nb_dir)}})
-        client.execute()
-        nbformat.write(nb, Path(out_dir) / path.name)
-        written.append(Path(out_dir) / path.name)
-    return written
+    return run_notebooks(out_dir, "1[0-9]_*.ipynb", timeout=timeout)
 
 
 def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, progress=True, scenario=None,

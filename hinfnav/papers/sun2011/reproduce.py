@@ -12,6 +12,7 @@ from ...core.progress import bar_disabled
 from ...core.provenance import provenance
 from ...metrics.errors import rms_per_run
 from ...plotting.save import save_figure
+from ..notebooks import run_notebooks
 from .constants import CITATION
 from .designs import design_for_scenario
 from .figures import fig2, fig3, fig4, fig5, fig6, fig7, fig7_result, paper_runs
@@ -58,20 +59,7 @@ def _summary(tab, designed, observer, fig7_res, scenario):
 
 def execute_notebooks(out_dir, timeout=900):
     """Execute every ``notebooks/NN_*.ipynb`` of the repository into ``out_dir``."""
-    import nbformat
-    from nbclient import NotebookClient
-
-    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
-    if not nb_dir.is_dir():
-        raise InputError(f"--notebooks needs the repository's notebooks/ folder next to the package; not found at {nb_dir}")
-    written = []
-    for path in tqdm(sorted(nb_dir.glob("[0-9][0-9]_*.ipynb")), disable=bar_disabled(True), desc="notebooks", unit="nb"):
-        nb = nbformat.read(path, as_version=4)
-        NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(nb_dir)}}).execute()
-        target = Path(out_dir) / path.name
-        nbformat.write(nb, target)
-        written.append(target)
-    return written
+    return run_notebooks(out_dir, "[0-9][0-9]_*.ipynb", timeout=timeout)
 
 
 def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=True, scenario=None):

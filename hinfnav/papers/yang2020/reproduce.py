@@ -17,11 +17,13 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
+from ...core.outputs import to_json as _to_json
 from ...core.outputs import write_json
 from ...core.progress import bar_disabled
 from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...plotting.save import save_figure
+from ..notebooks import run_notebooks
 from .claims import evaluate_claims
 from .constants import CITATION, READING_REASONS, REQUIREMENT_ASD, TABLE2
 from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12
@@ -53,35 +55,12 @@ READING_RUNS = {
 
 def to_json(obj):
     """Plain Python (dicts, lists, floats) from numpy values, NaN and infinities as None (JSON has neither)."""
-    if isinstance(obj, dict):
-        return {str(k): to_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_json(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_json(obj.tolist())
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        obj = obj.item()
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None  # JSON has no NaN or infinity
-    return obj
+    return _to_json(obj, strict=True)
 
 
 def execute_notebooks(out_dir, timeout=900):
     """Execute this paper's notebooks (``notebooks/3N_*.ipynb``) into ``out_dir``."""
-    import nbformat
-    from nbclient import NotebookClient
-
-    nb_dir = Path(__file__).resolve().parents[3] / "notebooks"
-    if not nb_dir.is_dir():
-        raise InputError(f"notebooks=True needs the repository's notebooks/ folder; not found at {nb_dir}")
-    written = []
-    for path in sorted(nb_dir.glob("3[0-9]_*.ipynb")):
-        nb = nbformat.read(path, as_version=4)
-        client = NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(nb_dir)}})
-        client.execute()
-        nbformat.write(nb, Path(out_dir) / path.name)
-        written.append(Path(out_dir) / path.name)
-    return written
+    return run_notebooks(out_dir, "3[0-9]_*.ipynb", timeout=timeout)
 
 
 def _save(fig, out, name, formats, prov):
