@@ -31,13 +31,7 @@ from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence, inv_spd, matmul_shared
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
-from .base import (
-    EstimateHistory,
-    Estimator,
-    FilterState,
-    StepOutput,
-    check_estimator_inputs,
-)
+from .base import Estimator, FilterState, StepOutput
 from .kalman import OUTPUTS
 
 __all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF", "joseph_update"]
@@ -248,46 +242,6 @@ class AugmentedEKF(Estimator):
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
         return FilterState(x=x, P=PhiPPhiT + Qd, k=state.k + 1, extra=extra)
-
-    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
-        """As :meth:`Estimator.estimate` (same numbers), with two economies for long runs.
-
-        ``keep_covariance`` may be ``"diagonal"`` (keep the variances only,
-        shape (runs, n_samples, n)); ``diagnostics`` may name the diagnostics
-        to keep (an iterable of keys) instead of True (all) or False (none).
-        """
-        if keep_covariance not in (True, False, "diagonal"):
-            raise InputError(f"keep_covariance must be True, False or 'diagonal'; got {keep_covariance!r}")
-        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None)
-        keys = None if diagnostics is True else set(diagnostics or ())
-        runs, n1, _ = y.shape
-        state = self.start(xhat0, P0, runs)
-        xhat = np.empty((runs, n1, self.n_state))
-        P_hist, shared, diag = None, False, {}
-        for k in range(n1):
-            state, out = self.update(state, y[:, k])
-            xhat[:, k] = out.xhat
-            if keep_covariance:
-                P = np.diagonal(out.P, axis1=-2, axis2=-1) if keep_covariance == "diagonal" else out.P
-                if P_hist is None:
-                    shared = P.strides[0] == 0
-                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[1:])
-                if shared:
-                    P_hist[k] = P[0]
-                else:
-                    P_hist[:, k] = P
-            for key, val in out.diagnostics.items():
-                if keys is None or key in keys:
-                    if key not in diag:
-                        diag[key] = np.empty((runs, n1) + np.shape(val)[1:], dtype=np.asarray(val).dtype)
-                    diag[key][:, k] = val
-            if k < n1 - 1:
-                state = self.predict(state, u[:, k])
-        if shared:
-            P_hist.setflags(write=False)
-            P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
-        return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state, diagnostics=diag)
 
     @staticmethod
     def _runs(P, runs):

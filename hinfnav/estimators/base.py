@@ -35,7 +35,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_vector
 
-__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs"]
+__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "history_keys"]
 
 
 @dataclass
@@ -111,6 +111,22 @@ class EstimateHistory:
     def units(self):
         """State units (from the system)."""
         return None if self.state is None else self.state.units
+
+
+def history_keys(keep_covariance, diagnostics):
+    """Check the history options of :meth:`Estimator.estimate`; the diagnostics to keep (None: all)."""
+    if keep_covariance not in (True, False, "diagonal"):
+        raise InputError(f"keep_covariance must be True, False or 'diagonal'; got {keep_covariance!r}")
+    if diagnostics is True:
+        return None
+    if diagnostics is False or diagnostics is None:
+        return set()
+    if isinstance(diagnostics, str):
+        return {diagnostics}
+    try:
+        return set(diagnostics)
+    except TypeError:
+        raise InputError(f"diagnostics must be True, False or names of diagnostics; got {diagnostics!r}") from None
 
 
 def check_estimator_inputs(y, u, xhat0, n_state, n_meas=None, n_input=None):
@@ -221,37 +237,41 @@ class Estimator:
             Prior estimate of x(0).
         P0 : array_like, shape (n, n), optional
             Initial covariance (filters that carry one; their default otherwise).
-        keep_covariance : bool
-            Return the covariance history.
-        diagnostics : bool
-            Return the diagnostics histories.
+        keep_covariance : bool or "diagonal"
+            Return the covariance history (True), its diagonal only (the
+            variances, shape (runs, n_samples, n): a long run's economy), or
+            none (False).
+        diagnostics : bool or iterable of str
+            Return the diagnostics histories: all (True), none (False), or
+            those named.
 
         Returns
         -------
         EstimateHistory
         """
+        keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None)
+        core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)
         xhat = np.empty((runs, n1, self.n_state))
-        P_hist = None
-        shared = False
-        diag = {}
+        P_hist, shared, diag = None, False, {}
         for k in range(n1):
             state, out = self.update(state, y[:, k])
             xhat[:, k] = out.xhat
             if keep_covariance and out.P is not None:
+                P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
                 if P_hist is None:
-                    # a covariance shared by every run (broadcast, stride 0) is stored once
-                    shared = out.P.ndim == 2 or out.P.strides[0] == 0
-                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + out.P.shape[-2:])
+                    # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
+                    shared = P.ndim == core or P.strides[0] == 0
+                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
                 if shared:
-                    P_hist[k] = out.P if out.P.ndim == 2 else out.P[0]
+                    P_hist[k] = P if P.ndim == core else P[0]
                 else:
-                    P_hist[:, k] = out.P
-            if diagnostics:
-                for key, val in out.diagnostics.items():
+                    P_hist[:, k] = P
+            for key, val in out.diagnostics.items():
+                if keys is None or key in keys:
                     val = np.asarray(val)
                     if key not in diag:
                         diag[key] = np.empty((runs, n1) + val.shape[1:], dtype=val.dtype)

@@ -27,8 +27,6 @@ rows), ``iterations`` and ``converged`` of the M-estimation, and the
 ``innovation``.
 """
 
-import numpy as np
-
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive
 from .huber import huber_correct, whitening

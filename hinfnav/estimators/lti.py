@@ -5,7 +5,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
 
 __all__ = ["LTIFilter"]
 
@@ -103,6 +103,7 @@ class LTIFilter(Estimator):
 
     def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
         """Vectorized over runs and fast: same numbers as the step loop (bitwise)."""
+        history_keys(keep_covariance, diagnostics)  # checked; the filter has neither a covariance nor diagnostics
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None)
         runs, n1, _ = y.shape

@@ -39,7 +39,7 @@ from ..analysis.hinf_riccati import max_admissible_theta
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
 
 __all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
 
@@ -205,8 +205,10 @@ class RecursiveHInfinityFilter(Estimator):
 
     def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
         """Batch path: the (data-independent) gain sequence once, then all runs at once; same numbers as the steps."""
+        keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None)
+        diagnostics = keys is None or bool(keys)
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)
         P, steady = state.P, None
@@ -240,8 +242,11 @@ class RecursiveHInfinityFilter(Estimator):
         if keep_covariance:
             P_hist.setflags(write=False)
             out_P = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
+            if keep_covariance == "diagonal":
+                out_P = np.diagonal(out_P, axis1=-2, axis2=-1)
         diag = {}
         if diagnostics:
             diag = {"innovation": innov, "existence_margin": np.broadcast_to(margins, (runs, n1)).copy(),
                     "existence_ok": np.broadcast_to(oks, (runs, n1)).copy()}
+            diag = {key: val for key, val in diag.items() if keys is None or key in keys}
         return EstimateHistory(xhat=xhat, P=out_P, state=self.system.state, diagnostics=diag)
