@@ -1,4 +1,4 @@
-"""The matrices of LMI (20) (Theorem 1 of Sun et al. 2011) and of its observer-form variant.
+"""The matrices of LMI (20) (Theorem 1 of Sun et al. 2011) and of its observer-form variant; the error-system check.
 
 Written once for both numbers (``bmat=np.block``: certification) and cvxpy
 expressions (``bmat=cvxpy.bmat``: the solver), so the certificate evaluates
@@ -7,7 +7,10 @@ exactly the matrix the solver was given.
 
 import numpy as np
 
-__all__ = ["lmi20_matrix", "observer_lmi_matrix", "gamma_index"]
+from ..core.exceptions import InputError
+from ..core.validation import as_matrix
+
+__all__ = ["lmi20_matrix", "observer_lmi_matrix", "gamma_index", "error_system_matrices"]
 
 
 def lmi20_matrix(A, B, C, D, L, H, E, R, S, Abar_F, Bbar_F, Cbar_F, lam, gamma2, bmat=np.block):
@@ -147,3 +150,22 @@ def gamma_index(n, p, q):
     return np.arange(4 * n, 4 * n + p + q)
 
 
+
+
+def error_system_matrices(Abar, Bbar, Cbar, Hbar=None, Ebar=None):
+    """Check the uncertain error system (13) ``(Ā, B̄, C̄, H̄, Ē)`` of an LMI; return them as float matrices.
+
+    Shapes: Ā (N, N), B̄ (N, ·), C̄ (·, N), H̄ (N, ·) and Ē (·, N), the last
+    two given together or not at all; an :class:`InputError` names the one
+    that is wrong.
+    """
+    Abar = as_matrix("Abar", Abar)
+    N = Abar.shape[0]
+    Bbar = as_matrix("Bbar", Bbar, (N, None))
+    Cbar = as_matrix("Cbar", Cbar, (None, N))
+    if (Hbar is None) != (Ebar is None):
+        raise InputError("Hbar and Ebar must be given together")
+    if Hbar is not None:
+        Hbar = as_matrix("Hbar", Hbar, (N, None))
+        Ebar = as_matrix("Ebar", Ebar, (None, N))
+    return Abar, Bbar, Cbar, Hbar, Ebar

@@ -12,8 +12,7 @@ import numpy as np
 
 from ..analysis.certificates import LMICertificate, brl_blocks, schur_gamma
 from ..core.linalg import sym
-from ..core.exceptions import InputError
-from ..core.validation import as_matrix
+from .blocks import error_system_matrices
 
 __all__ = ["robust_bounded_real_lmi"]
 
@@ -52,15 +51,7 @@ def robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None,
     -------
     LMICertificate
     """
-    Abar = as_matrix("Abar", Abar)
-    N = Abar.shape[0]
-    Bbar = as_matrix("Bbar", Bbar, (N, None))
-    Cbar = as_matrix("Cbar", Cbar, (None, N))
-    if (Hbar is None) != (Ebar is None):
-        raise InputError("Hbar and Ebar must be given together")
-    if Hbar is not None:
-        Hbar = as_matrix("Hbar", Hbar, (N, None))
-        Ebar = as_matrix("Ebar", Ebar, (None, N))
+    Abar, Bbar, Cbar, Hbar, Ebar = error_system_matrices(Abar, Bbar, Cbar, Hbar, Ebar)
     solvers = ("CLARABEL", "CVXOPT") if solver is None else (solver,)
     best = None
     for slv in solvers:

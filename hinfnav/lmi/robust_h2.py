@@ -27,8 +27,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..analysis.certificates import schur_gamma
-from ..core.exceptions import InputError
-from ..core.validation import as_matrix
+from .blocks import error_system_matrices
 from .mixed_blocks import extended_h2_matrix
 from .solve import solver_kwargs
 
@@ -95,15 +94,7 @@ def robust_h2_bound(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None, margin=
     -------
     H2Certificate
     """
-    Abar = as_matrix("Abar", Abar)
-    N = Abar.shape[0]
-    Bbar = as_matrix("Bbar", Bbar, (N, None))
-    Cbar = as_matrix("Cbar", Cbar, (None, N))
-    if (Hbar is None) != (Ebar is None):
-        raise InputError("Hbar and Ebar must be given together")
-    if Hbar is not None:
-        Hbar = as_matrix("Hbar", Hbar, (N, None))
-        Ebar = as_matrix("Ebar", Ebar, (None, N))
+    Abar, Bbar, Cbar, Hbar, Ebar = error_system_matrices(Abar, Bbar, Cbar, Hbar, Ebar)
     best = None
     for slv in ("CVXOPT", "CLARABEL") if solver is None else (solver,):
         cert = _once(Abar, Bbar, Cbar, Hbar, Ebar, slv, margin, bound, accuracy)
