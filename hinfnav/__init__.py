@@ -18,6 +18,8 @@ command line starts fast.
 
 import importlib
 
+from .core.provenance import package_version
+
 #: Public name -> the module (relative to this package) it comes from.
 _EXPORTS = {
     "h2_norm": "analysis",
@@ -105,6 +107,9 @@ _EXPORTS = {
 
 
 def __getattr__(name):
+    if name == "__version__":  # from git in a checkout (see core.provenance.package_version); computed once
+        globals()[name] = value = package_version()
+        return value
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'hinfnav' has no attribute {name!r}")
@@ -116,8 +121,6 @@ def __getattr__(name):
 def __dir__():
     return sorted(set(globals()) | set(_EXPORTS))
 
-
-__version__ = "0.2.0"
 
 __all__ = [
     "__version__",

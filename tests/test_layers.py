@@ -22,7 +22,8 @@ PACKAGE = ROOT / "hinfnav"
 #: (notebook execution, figure objects). A function-local import of the package itself
 #: anywhere else would dodge an import cycle: refused.
 LOCAL_IMPORT_ALLOWED = {"hinfnav/cli.py": "deferred imports: each command loads only the layers it needs"}
-HEAVY_OPTIONAL = ("nbformat", "nbclient", "matplotlib", "papermill", "distributed", "dask")
+HEAVY_OPTIONAL = ("nbformat", "nbclient", "matplotlib", "papermill", "distributed", "dask",
+                  "setuptools_scm")  # the version from git, only in a source checkout
 
 
 def _modules():

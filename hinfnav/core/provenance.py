@@ -17,8 +17,25 @@ __all__ = ["provenance", "package_version", "git_commit", "LIBRARIES"]
 LIBRARIES = ("numpy", "scipy", "cvxpy", "control", "filterpy", "matplotlib")
 
 
+def _source_root():
+    return Path(__file__).resolve().parents[2]
+
+
 def package_version():
-    """hinfnav's installed version (the source tree's when not installed)."""
+    """hinfnav's version: from git in a source checkout, else the installed distribution's.
+
+    In a checkout the version is recomputed from the repository (setuptools-scm: the last tag
+    ``vX.Y.Z``, then ``X.Y.(Z+1).devN+g<commit>`` N commits after it, ``.d<date>`` when the tree is
+    dirty), so an editable install reports the commit it runs, not the one it was installed at.
+    """
+    root = _source_root()
+    if (root / ".git").exists():
+        try:
+            from setuptools_scm import get_version  # optional at run time; the build uses it
+
+            return get_version(root=str(root), version_scheme="guess-next-dev", local_scheme="node-and-date")
+        except Exception:  # noqa: BLE001 - no setuptools-scm, no git, a shallow clone: fall back to metadata
+            pass
     try:
         return metadata.version("hinfnav")
     except metadata.PackageNotFoundError:  # pragma: no cover - running from a bare source tree
@@ -27,7 +44,7 @@ def package_version():
 
 def git_commit():
     """The commit of the source tree (with ``+dirty`` if it has uncommitted changes), or None."""
-    root = Path(__file__).resolve().parents[2]
+    root = _source_root()
     if not (root / ".git").exists():
         return None
     try:
