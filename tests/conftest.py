@@ -12,6 +12,55 @@ from hinfnav.core import spectral_radius
 from hinfnav.metrics import rms_per_run
 from hinfnav.papers.sun2011 import Scenario
 
+#: Tests marked ``slow`` (each took at least 1 s, fixture set-up included, in ``pytest --durations=0``
+#: on the 2-core CI machine); every notebook is ``slow`` and ``notebook`` too. ``pytest -m "not slow"``
+#: is the contributor's inner loop; CI runs everything.
+SLOW = {
+    "tests/test_attitude2018_filters.py::test_thrust_augmentation_fixes_the_first_500_s_of_the_maneuver",
+    "tests/test_bad_inputs.py::test_cli_subprocess_has_no_traceback",
+    "tests/test_campaign.py::test_bad_spec_files_and_clients",
+    "tests/test_campaign.py::test_two_worker_cluster_gives_bitwise_the_serial_numbers",
+    "tests/test_cli.py::test_bad_input_gives_a_clear_message_not_a_traceback",
+    "tests/test_cli.py::test_simulate_json_fields",
+    "tests/test_cli_mixed.py::test_design_h2_front_reports_the_knee",
+    "tests/test_contract.py::test_converges_without_noise_on_a_stable_problem",
+    "tests/test_design.py::test_observer_gamma_is_at_least_general_and_passes_through_sweep",
+    "tests/test_design.py::test_solvers_agree_and_gamma_nondecreasing",
+    "tests/test_design_corner_cases.py::test_loose_certificate_warns_with_both_numbers",
+    "tests/test_generic_layers.py::test_closed_loop_on_the_estimate_converges_like_the_ideal_loop",
+    "tests/test_mixed_h2hinf.py::test_front_is_monotone_and_every_point_certified",
+    "tests/test_mixed_h2hinf.py::test_near_gamma_star_the_filter_reaches_the_hinf_optimum",
+    "tests/test_notebook_parameters.py::test_notebook_labels_follow_the_parameters",
+    "tests/test_sun2011_closed_loop.py::test_every_loop_reaches_the_target",
+    "tests/test_table1.py::test_each_row_is_reproduced_by_the_command_it_names",
+    "tests/test_table1.py::test_table1_cell",
+}
+#: Test files (or single tests) that run a paper's whole ``reproduce`` pipeline: ``reproduce`` and ``slow``.
+REPRODUCE = (
+    "tests/test_attitude2018_reproduce.py",
+    "tests/test_outputs.py::test_interrupted_and_concurrent_reproduce_never_mix_two_runs",
+    "tests/test_paper_notebooks.py::test_run_notebooks_executes_the_matching_notebooks_into_the_folder",
+    "tests/test_reproduce_regression.py",
+    "tests/test_shi2018_reproduce.py",
+    "tests/test_sun2011_reproduce.py",
+    "tests/test_yang2020_reproduce.py",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Add the ``slow``, ``notebook`` and ``reproduce`` markers (declared in pyproject.toml)."""
+    for item in items:
+        nodeid = item.nodeid.split("[")[0]
+        if nodeid.endswith(".ipynb") or ".ipynb::" in nodeid:
+            item.add_marker(pytest.mark.notebook)
+            item.add_marker(pytest.mark.slow)
+        if nodeid in SLOW:
+            item.add_marker(pytest.mark.slow)
+        if nodeid.startswith(REPRODUCE):
+            item.add_marker(pytest.mark.reproduce)
+            item.add_marker(pytest.mark.slow)
+
+
 #: Length and error window of the short scenario (600 steps of 0.1 s).
 SHORT_DURATION_S = 60.0
 SHORT_WINDOW_S = (10.0, 60.0)
