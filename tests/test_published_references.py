@@ -37,7 +37,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from hinfnav.analysis import hinf_norm, hinf_norm_bisection, steady_state_hinf, steady_state_kalman
+from hinfnav.analysis import hinf_norm, hinf_norm_bisection, hinf_norm_grid, steady_state_hinf, steady_state_kalman
+from hinfnav.core.exceptions import InputError
 from hinfnav.estimators import ExtendedKalmanFilter
 from hinfnav.estimators.base import FilterState
 from hinfnav.systems import LinearMeasurement, LinearSystem, StateSpec
@@ -171,6 +172,15 @@ def test_darex_closed_form_solutions(name, A, B, Q, R, X, rtol):
     assert np.max(np.abs(X_ctrl - X)) <= max(rtol, 1e-7) * scale, name
 
 
+def test_darex_singular_r_is_refused():
+    """DAREX 1.1 (Van Dooren 1981, R = 0, X = I) is outside hinfnav's Riccati routines: a clear error naming R."""
+    A, B, Q = np.array([[2.0, -1.0], [1.0, 0.0]]), np.array([[1.0], [0.0]]), np.array([[0.0, 0.0], [0.0, 1.0]])
+    with pytest.raises(InputError, match=r"\bR\b"):
+        steady_state_kalman(A.T, B.T, Q, np.zeros((1, 1)))
+    with pytest.raises(InputError, match=r"\bR\b"):
+        steady_state_hinf(A.T, B.T, Q, np.zeros((1, 1)), 0.0)
+
+
 def test_bb02ad_printed_example():
     """BB02AD's printed example (Example 2.3, eps = 0.1234): X printed in F8.4."""
     eps = DATA["BB02AD"]["example_2_3_eps"]
@@ -216,27 +226,25 @@ def test_sb10dd_closed_loop_norm_below_printed_gamma():
     np.testing.assert_allclose(rcond, d["rcond"], rtol=1e-3)
     loop = _sb10dd_closed_loop(AK, BK, CK, DK)
     gamma = d["gamma"]
-    g_slicot, peak = hinf_norm(loop, return_peak=True)
-    g_own = hinf_norm_bisection(loop)
+    g_slicot, g_own = hinf_norm(loop), hinf_norm_bisection(loop)
     assert g_slicot < gamma and g_own < gamma  # the published guarantee: ||T_zw||∞ < γ
     assert abs(g_own - g_slicot) <= 1e-8 * g_slicot  # hinfnav's two norms agree (both asked 1e-10)
-    assert abs(abs(peak) - np.pi) <= 1e-6  # the peak sits at the Nyquist frequency (dt unspecified: rad/sample)
-    # γ was chosen near the optimum: the norm is within 1e-5 of it (the example's γ has 6 digits)
-    assert g_own > gamma * (1.0 - 1e-5)
+    # a dense frequency grid gives a lower bound of the same norm (measured: 111.29389 at ω = π rad/sample)
+    assert hinf_norm_grid(loop) <= g_own * (1.0 + 1e-10)
 
 
 def test_sb10dd_printed_digits_alone():
     """The controller as printed (4 decimals) stabilises the plant, but its loop exceeds the printed γ.
 
     A finding about the published data, not about hinfnav: rounding AK..DK to 4 decimals
-    moves the closed-loop norm from 111.2939 to 111.875 (+0.5 %), above γ = 111.294.
-    Both hinfnav norms are asserted to agree on it.
+    moves the closed-loop norm from 111.2939 to 111.8753 (+0.5 %, measured), above γ = 111.294.
+    So a check of a printed controller must start from SLICOT's full-precision output, as above.
     """
     loop = _sb10dd_closed_loop(*(_m("SB10DD", k) for k in ("AK", "BK", "CK", "DK")))
-    assert np.max(np.abs(np.linalg.eigvals(loop.A))) < 1.0
+    assert np.max(np.abs(np.linalg.eigvals(loop.A))) < 1.0  # still internally stable (radius 0.816)
     g_slicot, g_own = hinf_norm(loop), hinf_norm_bisection(loop)
     assert abs(g_own - g_slicot) <= 1e-8 * g_slicot
-    assert DATA["SB10DD"]["gamma"] < g_own < 1.01 * DATA["SB10DD"]["gamma"]
+    assert g_own > DATA["SB10DD"]["gamma"]
 
 
 # -- AB13DD: a norm whose peak is 2e-6 rad/s wide ---------------------------------------------------
