@@ -11,7 +11,8 @@ What is checked, and with which hinfnav routine:
 
 * FB01VD (one Kalman step) and FB01QD (three square-root Kalman steps):
   :class:`hinfnav.estimators.ExtendedKalmanFilter` on a ``LinearSystem`` and
-  a ``LinearMeasurement`` (its Joseph-form ``correct`` and its ``predict``).
+  a ``LinearMeasurement`` (its Joseph-form ``correct`` and its ``predict``), and
+  the augmented filters' ``joseph_update``.
 * DAREX (BB02AD): the closed-form DARE solutions of the benchmark collection
   against :func:`hinfnav.analysis.steady_state_kalman` and
   :func:`hinfnav.analysis.steady_state_hinf` at θ = 0, on the dual (filtering)
@@ -37,9 +38,16 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from hinfnav.analysis import hinf_norm, hinf_norm_bisection, hinf_norm_grid, steady_state_hinf, steady_state_kalman
+from hinfnav.analysis import (
+    hinf_norm,
+    hinf_norm_bisection,
+    hinf_norm_grid,
+    steady_state_hinf,
+    steady_state_kalman,
+)
 from hinfnav.core.exceptions import InputError
 from hinfnav.estimators import ExtendedKalmanFilter
+from hinfnav.estimators.augmented import joseph_update
 from hinfnav.estimators.base import FilterState
 from hinfnav.systems import LinearMeasurement, LinearSystem, StateSpec
 
@@ -82,6 +90,10 @@ def test_fb01vd_one_kalman_step():
     # because this Q is not a covariance (indefinite) and the filter refuses it as one.
     P_next = kf.predict(posterior).P + B @ Q @ B.T
     np.testing.assert_allclose(P_next, _m("FB01VD", "P_next"), rtol=0, atol=F84)
+    # the augmented filters' own correction (E2), the same step
+    dx, P_post = joseph_update(P, C, R, np.eye(2))
+    np.testing.assert_allclose(dx.T, _m("FB01VD", "K"), rtol=0, atol=F84)
+    np.testing.assert_allclose(A @ P_post @ A.T + B @ Q @ B.T, _m("FB01VD", "P_next"), rtol=0, atol=F84)
 
 
 def test_fb01qd_three_square_root_steps():
