@@ -9,7 +9,7 @@ compared to half a unit of its last decimal, 5e-5.
 
 What is checked, and with which hinfnav routine:
 
-* FB01VD (one Kalman step) and FB01QD (three square-root Kalman steps):
+* FB01VD (one Kalman step), FB01QD and FB01RD (three square-root Kalman steps):
   :class:`hinfnav.estimators.ExtendedKalmanFilter` on a ``LinearSystem`` and
   a ``LinearMeasurement`` (its Joseph-form ``correct`` and its ``predict``), and
   the augmented filters' ``joseph_update``.
@@ -96,22 +96,26 @@ def test_fb01vd_one_kalman_step():
     np.testing.assert_allclose(A @ P_post @ A.T + B @ Q @ B.T, _m("FB01VD", "P_next"), rtol=0, atol=F84)
 
 
-def test_fb01qd_three_square_root_steps():
-    """FB01QD (doc/FB01QD.html): three steps from P = 0; the printed S (S Sᵀ = P(4|3)) and the 3rd gain."""
-    A, B, Qs, C, Rs = (_m("FB01QD", k) for k in ("A", "B", "Q_sqrt", "C", "R_sqrt"))
+@pytest.mark.parametrize("routine", ["FB01QD", "FB01RD"])
+def test_square_root_filter_three_steps(routine):
+    """FB01QD, FB01RD (doc/<routine>.html): three steps from P = 0; the printed S (S Sᵀ = P(4|3)), the 3rd gain.
+
+    FB01RD is the same filter for a Hessenberg A and a triangular C, with its own data and results.
+    """
+    A, B, Qs, C, Rs = (_m(routine, k) for k in ("A", "B", "Q_sqrt", "C", "R_sqrt"))
     Qw = B @ Qs @ Qs.T @ B.T
     kf = _kalman(A, C, Rs @ Rs.T)
     state = FilterState(x=np.zeros((2, 4)), P=np.zeros((4, 4)))
-    steps = DATA["FB01QD"]["steps"]
+    steps = DATA[routine]["steps"]
     for step in range(1, steps + 1):
         # zero readings keep x̂ = 0; at the last step unit readings give A K_filtered, FB01QD's gain
         y = np.eye(2) if step == steps else np.zeros((2, 2))
         posterior, _ = kf.update(state, y)
         predicted = kf.predict(posterior)
         state = FilterState(x=predicted.x if step == steps else np.zeros((2, 4)), P=predicted.P + Qw, k=predicted.k)
-    np.testing.assert_allclose(state.x.T, _m("FB01QD", "K"), rtol=0, atol=F84)
+    np.testing.assert_allclose(state.x.T, _m(routine, "K"), rtol=0, atol=F84)
     # The printed S is a Cholesky factor up to the signs of its columns.
-    S_printed = _m("FB01QD", "S")
+    S_printed = _m(routine, "S")
     S_printed = S_printed * np.sign(np.diag(S_printed))
     np.testing.assert_allclose(np.linalg.cholesky(state.P), S_printed, rtol=0, atol=F84)
 
