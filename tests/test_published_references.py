@@ -9,7 +9,8 @@ compared to half a unit of its last decimal, 5e-5.
 
 What is checked, and with which hinfnav routine:
 
-* FB01VD (one Kalman step), FB01QD and FB01RD (three square-root Kalman steps):
+* FB01VD (one Kalman step), FB01QD and FB01RD (three square-root covariance steps),
+  FB01SD and FB01TD (three square-root information steps, with the filtered state):
   :class:`hinfnav.estimators.ExtendedKalmanFilter` on a ``LinearSystem`` and
   a ``LinearMeasurement`` (its Joseph-form ``correct`` and its ``predict``), and
   the augmented filters' ``joseph_update``.
@@ -118,6 +119,37 @@ def test_square_root_filter_three_steps(routine):
     S_printed = _m(routine, "S")
     S_printed = S_printed * np.sign(np.diag(S_printed))
     np.testing.assert_allclose(np.linalg.cholesky(state.P), S_printed, rtol=0, atol=F84)
+
+
+@pytest.mark.parametrize("routine", ["FB01SD", "FB01TD"])
+def test_square_root_information_filter_three_steps(routine):
+    """FB01SD, FB01TD (doc/<routine>.html): three information-filter steps; the printed S⁻¹ and filtered X.
+
+    The data are in information form; they are turned into the covariance form hinfnav's filter
+    takes: A = (A⁻¹)⁻¹, Q = (QINVᵀ QINV)⁻¹, R = (RINVᵀ RINV)⁻¹, P(0|0) = (SINVᵀ SINV)⁻¹,
+    y = RINV⁻¹ (R^(-1/2) y). The documented pre-array has the row [S⁻¹A⁻¹B, S⁻¹A⁻¹ | S⁻¹X], i.e.
+    S⁻¹A⁻¹(x(i+1) + B w(i)) = S⁻¹x(i): the model is x(i+1) = A x(i) − B w(i) with E w(i) = Z, so the
+    filter is told the known input u = −Z through Γ = B (with +Z the state would differ; the
+    covariance does not depend on the sign).
+    """
+    AINV, C, RINV, AINVB, QINV, SINV = (_m(routine, k) for k in ("AINV", "C", "RINV", "AINVB", "QINV", "SINV"))
+    Z, X, RINVY = (_m(routine, k) for k in ("Z", "X", "RINVY"))
+    A = np.linalg.inv(AINV)
+    B = A @ AINVB
+    Q, R = np.linalg.inv(QINV.T @ QINV), np.linalg.inv(RINV.T @ RINV)
+    n = A.shape[0]
+    system = LinearSystem(A, B, np.zeros((n, 1)), 1.0, StateSpec(tuple(f"s{i}" for i in range(n)), ("",) * n))
+    kf = ExtendedKalmanFilter(system, LinearMeasurement(C, np.linalg.cholesky(R)), P0=np.linalg.inv(SINV.T @ SINV),
+                              Q=B @ Q @ B.T, R=R, uses_input=True)
+    y = np.linalg.solve(RINV, RINVY)
+    state = kf.start(X)
+    for _ in range(DATA[routine]["steps"]):
+        state, out = kf.update(kf.predict(state, u=-Z[None]), y[None])
+    np.testing.assert_allclose(out.xhat[0], _m(routine, "X_result"), rtol=0, atol=F84)
+    # S⁻¹ is an upper Cholesky factor of the information matrix P(3|3)⁻¹, up to the signs of its rows
+    S_inv = _m(routine, "SINV_result")
+    S_inv = np.sign(np.diag(S_inv))[:, None] * S_inv
+    np.testing.assert_allclose(np.linalg.cholesky(np.linalg.inv(out.P[0])).T, S_inv, rtol=0, atol=F84)
 
 
 # -- DAREX: discrete algebraic Riccati equations with exact solutions ------------------------------
