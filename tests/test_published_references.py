@@ -28,7 +28,10 @@ What is checked, and with which hinfnav routine:
 
 SLICOT's continuous Riccati examples (SB02OD, SB02MD, SB02RD: continuous
 DICO = 'C') have no counterpart here: hinfnav's Riccati routines are
-discrete-time only.
+discrete-time only. The two-state benchmark plant of the robust-filtering
+papers (de Oliveira, Geromel & Bernussou; Xie et al. 2004) has no test here
+either: their printed γ tables could not be reached, and no number is
+written down that was not read from a printed source.
 """
 
 import pathlib
