@@ -53,7 +53,6 @@ class CellAccumulator:
         self.runs = int(runs)
         self.tol = tol
         self.state = None
-        self.nonfinite = 0
         self._masks = None
         self._conv = []
         self.consistency = ConsistencyAccumulator(self.runs)
@@ -80,8 +79,6 @@ class CellAccumulator:
             self._per_run = {name: np.empty((self.runs, n)) for name in self.windows}
             if self.tol is not None:
                 self._tol = np.broadcast_to(np.asarray(self.tol, dtype=float), (n,))
-        finite = np.all(np.isfinite(err), axis=(1, 2))
-        self.nonfinite += int((~finite).sum())
         b = err.shape[0]
         sq_all = err * err
         for name, m in self._masks.items():
@@ -95,6 +92,11 @@ class CellAccumulator:
         if self.tol is not None:
             self._conv.append(_convergence(err, t, self._tol))
         self.consistency.add(t, err, P, innovation, S, scale0)
+
+    @property
+    def nonfinite(self):
+        """Number of runs added whose errors are not all finite."""
+        return self.consistency.nonfinite_runs
 
     def window_statistics(self):
         """Name → :class:`~hinfnav.metrics.WindowStatistics` (the same object the streaming Monte Carlo returns)."""
