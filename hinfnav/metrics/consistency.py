@@ -47,7 +47,7 @@ batch; it is composed into the streaming statistics of
 """
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import chi2
@@ -296,7 +296,6 @@ class ConsistencyStatistics:
     max_growth: float = 0.0
     notes: tuple = ()
     name: str = "filter"
-    _cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def nees_bounds(self):
