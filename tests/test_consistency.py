@@ -149,6 +149,15 @@ def test_campaign_cell_carries_consistency():
     assert lti["statistics"]["consistency"]["windows"]["steady"]["nees"] is None
     rows = table[(table["quantity"] == "nees") & (table["statistic"] == "mean")]
     assert len(rows) == 2 and rows["value"].iloc[0] == c["windows"]["steady"]["nees"] and np.isnan(rows["value"].iloc[1])
+    # the EKF not told the thrust, under the maneuver: its covariance is far too small for its error (measured mean
+    # NEES ~3e4 against a bound of ~10), so the cell is flagged and the campaign warns; its runs did not blow up
+    with pytest.warns(FilterDivergenceWarning, match="ekf in cell .* beyond 10 times its 95 % upper bound"):
+        table = run_campaign(Campaign(**{**spec.as_dict(), "grid": {**spec.grid, "estimator": ["ekf"],
+                                                                     "maneuver": [True]}}),
+                             client="serial", progress=False)
+    (cell,) = table.attrs["cells"]
+    assert cell["diverged"] is True and cell["status"] == "ok" and cell["statistics"]["consistency"]["diverged_runs"] == 0
+    assert table[table["statistic"] == "diverged"]["value"].tolist() == [1.0]
 
 
 # -- strong tracking on an outlier track: flagged, never silent ---------------------------------------------------
@@ -167,10 +176,8 @@ def _outlier_track():
 def test_strong_tracking_on_outliers_is_flagged_diverged():
     sc, st, plain = _outlier_track()
     noise = ContaminatedNoise(eps=0.07, ratio=10.0)  # (1 − ε) N(0, σ²) + ε N(0, (10σ)²): 7 % outliers
-    with pytest.warns(FilterDivergenceWarning, match="strong_tracking.*initial error scale"):
-        with np.errstate(all="ignore"):
-            stats = monte_carlo_statistics(sc, st, windows={"late": sc.window_s}, runs=4, seed=0,
-                                           measurement_noise=noise)
+    with pytest.warns(FilterDivergenceWarning, match="strong_tracking.*initial error scale"), np.errstate(all="ignore"):
+        stats = monte_carlo_statistics(sc, st, windows={"late": sc.window_s}, runs=4, seed=0, measurement_noise=noise)
     s = stats.consistency_summary
     # the failure of the issue: the estimates stay finite while the error runs away (here beyond 1e90 m)
     assert np.all(np.isfinite(stats["late"].max_abs)) and stats["late"].max_abs[:3].max() > 1e90

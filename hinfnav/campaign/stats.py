@@ -104,7 +104,7 @@ class CellAccumulator:
                                        self._per_run[name], self._max[name])
                 for name in self.windows}
 
-    def result(self, name="filter"):
+    def result(self, filter_name="filter"):
         """JSON-ready statistics: per window and component, per window and state group, convergence, consistency."""
         st = self.state
         labels = list(st.labels) if st is not None else [f"x{i}" for i in range(self._sums[next(iter(self.windows))].size)]
@@ -130,7 +130,7 @@ class CellAccumulator:
         return {"labels": labels, "units": units,
                 "groups": {g: {"indices": list(idx), "unit": units[idx[0]]} for g, idx in groups.items()},
                 "windows": windows, "convergence": conv, "nonfinite_runs": self.nonfinite,
-                "consistency": self.consistency.result(name).summary(self.windows)}
+                "consistency": self.consistency.result(filter_name).summary(self.windows)}
 
 
 def rms_interval(ms):
