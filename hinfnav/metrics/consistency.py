@@ -371,8 +371,10 @@ def consistency(result, xhat0=None, windows=None):
     Parameters
     ----------
     result : SimulationResult
-        With its covariance ``P`` and, for the NIS, the diagnostics
-        :data:`NIS_KEYS` (``hinfnav.simulate`` keeps them).
+        With its covariance ``P`` (a kept diagonal only, ``keep_covariance="diagonal"``,
+        gives no NEES) and, for the NIS, the diagnostics :data:`NIS_KEYS`
+        (``hinfnav.simulate`` keeps them; ``simulate_nonlinear`` when asked:
+        ``keep_covariance=True, diagnostics=NIS_KEYS``).
     xhat0 : array_like, shape (n_stored,), optional
         The filters' initial estimate (for the initial error scale; default
         ``result.xhat0``).
