@@ -162,7 +162,7 @@ def test_toml_spec_and_command_line(tmp_path, capsys):
     assert main(["campaign", str(path), "--out", str(tmp_path / "out"), "--scheduler", "serial"]) == 0
     assert "8 cells (8 computed, 0 reused)" in capsys.readouterr().out
     table = pd.read_csv(tmp_path / "out" / "results.csv")
-    assert set(table["estimator"]) == {"published", "ekf"} and len(table) == 8 * (2 * 8 * 9 + 3)
+    assert set(table["estimator"]) == {"published", "ekf"} and len(table) == 8 * (2 * 8 * 9 + 3 + 2 + 2 * 2 * 5)  # + diverged, diverged_runs; NEES/NIS x 5 per window
     cell = json.loads(next((tmp_path / "out" / "cells").glob("*.json")).read_text())
     assert cell["status"] == "ok" and cell["runs"] == 5
     with pytest.raises(SystemExit):  # argparse: --workers applies to the LocalCluster only

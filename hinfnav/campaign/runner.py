@@ -15,6 +15,15 @@ whole or absent), so an interrupted campaign, run again into the same folder,
 computes only the cells that are missing. ``out_dir/campaign.json`` holds the
 spec and ``out_dir/results.csv`` the tidy table.
 
+Each cell also gets its consistency (NEES, NIS, χ² bounds, ``diverged``;
+:mod:`hinfnav.metrics.consistency`) and a ``diverged`` field: true when
+runs blew up (then the status is ``"diverged"`` too) or when the mean NEES
+is far beyond its bound (status ``"ok"``: the estimates are usable, the
+covariance is not); :func:`run_campaign` warns
+(:class:`~hinfnav.core.exceptions.FilterDivergenceWarning`) for each such
+cell it computes. The covariance histories this needs are kept for
+:data:`CONSISTENCY_BYTES` at most: a batch is run in chunks of runs below that.
+
 The numbers do not depend on the number of workers, the order of completion
 or a resume: each cell's seed comes from the spec (:mod:`.spec`), each run
 draws from its own child generator, and the batches are those of the spec's
@@ -37,6 +46,7 @@ from ..core.outputs import MARKER, check_output_dir, to_json
 from ..core.progress import bar_disabled
 from ..core.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
+from ..metrics.consistency import NIS_KEYS, initial_scale, warn_if_diverged
 from ..sim.montecarlo import check_measurement_match
 from ..sim.truth import simulate_truth
 from .registry import build_scenario, scenario_entry
@@ -48,6 +58,8 @@ __all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "camp
 
 #: ``client=SERIAL`` runs every task in this process, one after another (no cluster; for debugging and tests).
 SERIAL = "serial"
+#: Bytes of covariance, innovation and S histories one estimator run may keep (the runs of a batch are chunked below).
+CONSISTENCY_BYTES = 2**29
 
 _BUILT = {}  # per process: (scenario, settings, estimator, options) -> Estimator (designs are solved once)
 _MAX_BUILT = 64
@@ -114,7 +126,7 @@ def run_unit(unit):
     the estimators, simulates the truth batch by batch and runs every
     estimator of the unit on each batch. An estimator that fails is reported
     with ``status="error"`` (and is not written: a resume tries it again); one
-    whose estimates are not finite gets ``status="diverged"``.
+    whose estimates are not finite or whose error left the divergence bound gets ``status="diverged"``.
     """
     for module in unit["modules"]:
         importlib.import_module(module)
@@ -150,11 +162,7 @@ def run_unit(unit):
             try:
                 est = estimators[cid]
                 check_measurement_match(est, truth.measurement)
-                hist = est.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False)
-                err = truth.x - hist.xhat if truth.state is None else truth.state.error(truth.x, hist.xhat)
-                with np.errstate(all="ignore"):
-                    accs[cid].add(start, truth.t, err, truth.state)
-                del hist, err
+                _run_cell_batch(est, truth, scenario.xhat0, accs[cid], start)
             except Exception as exc:  # noqa: BLE001
                 errors[cid] = f"{type(exc).__name__}: {exc}"
             elapsed[cid] += time.perf_counter() - t0
@@ -171,10 +179,31 @@ def run_unit(unit):
         if cid in errors:
             res.update(status="error", error=errors[cid])
         else:
-            stats = accs[cid].result()
-            res.update(status="diverged" if stats["nonfinite_runs"] else "ok", statistics=stats)
+            stats = accs[cid].result(c["estimator"])
+            blown = stats["nonfinite_runs"] or stats["consistency"]["diverged_runs"]
+            res.update(status="diverged" if blown else "ok", diverged=stats["consistency"]["diverged"], statistics=stats)
         out.append(res)
     return out
+
+
+def _run_cell_batch(est, truth, xhat0, acc, start):
+    """Run one estimator on one truth batch, in chunks of runs whose histories fit :data:`CONSISTENCY_BYTES`."""
+    runs, n1, n = truth.x.shape
+    m = truth.y.shape[-1]
+    chunk = max(1, min(runs, CONSISTENCY_BYTES // (8 * n1 * (n * n + m * m + m))))
+    error = (lambda x, xh: x - xh) if truth.state is None else truth.state.error
+    for s in range(0, runs, chunk):
+        sl = slice(s, min(s + chunk, runs))
+        hist = est.estimate(truth.y[sl], truth.u[sl], xhat0, keep_covariance=True, diagnostics=NIS_KEYS)
+        x = truth.x[sl]
+        with np.errstate(all="ignore"):
+            err = error(x, hist.xhat)
+            P = hist.P if hist.P is not None and hist.P.ndim == 4 else None
+            scale0 = initial_scale(error(x[:, 0], np.broadcast_to(np.asarray(xhat0, dtype=float), x[:, 0].shape)),
+                                   None if P is None else P[:, 0], err[:, 0])
+            acc.add(start + s, truth.t, err, truth.state, P, hist.diagnostics.get(NIS_KEYS[0]),
+                    hist.diagnostics.get(NIS_KEYS[1]), scale0)
+        del hist, err, P
 
 
 class CellResults(tuple):
@@ -332,6 +361,8 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
             else:
                 computed += 1
                 results[res["cell_id"]] = res
+                warn_if_diverged(res["statistics"]["consistency"], f"{res['params'].get('estimator')} in cell "
+                                 f"{res['cell_id']}")
                 if out is not None:
                     _atomic_write(out / "cells" / f"{res['cell_id']}.json", json.dumps(_clean(res), indent=1) + "\n")
         bar.update(len(unit_results))

@@ -11,11 +11,15 @@ the per-run RMS, its 95 % interval (mean ± 1.96 s/√runs) and the 2.5–97.5 %
 one run follow; per run the convergence time when tolerances are given. On
 top of that, per state group (position, velocity): the RMS over the group's
 components (the root mean square of the per-axis RMS, as Table 1 of Sun 2011
-reports a single number), pooled and per run.
+reports a single number), pooled and per run. And the consistency of the
+cell (:class:`hinfnav.metrics.ConsistencyAccumulator`): the run-averaged NEES
+and NIS per step with their 95 % χ² bounds, per window their mean and the
+fraction of steps inside, and the ``diverged`` flag with its reasons.
 """
 
 import numpy as np
 
+from ..metrics.consistency import ConsistencyAccumulator
 from ..metrics.errors import window_mask
 from ..metrics.streaming import WindowStatistics
 
@@ -49,12 +53,18 @@ class CellAccumulator:
         self.runs = int(runs)
         self.tol = tol
         self.state = None
-        self.nonfinite = 0
         self._masks = None
         self._conv = []
+        self.consistency = ConsistencyAccumulator(self.runs)
 
-    def add(self, start, t, err, state):
-        """Add the errors ``err`` (shape (batch, samples, n)) of runs ``start … start + batch − 1``."""
+    def add(self, start, t, err, state, P=None, innovation=None, S=None, scale0=None):
+        """Add the errors ``err`` (shape (batch, samples, n)) of runs ``start … start + batch − 1``.
+
+        ``P``, ``innovation``, ``S`` and ``scale0``: the covariance history,
+        innovation and innovation covariance histories and initial error
+        scales of those runs, for the consistency statistics (see
+        :meth:`hinfnav.metrics.ConsistencyAccumulator.add`).
+        """
         if self._masks is None:
             # t is increasing, so each window is one contiguous range of samples: slices (views), not copies
             self._masks = {}
@@ -69,8 +79,6 @@ class CellAccumulator:
             self._per_run = {name: np.empty((self.runs, n)) for name in self.windows}
             if self.tol is not None:
                 self._tol = np.broadcast_to(np.asarray(self.tol, dtype=float), (n,))
-        finite = np.all(np.isfinite(err), axis=(1, 2))
-        self.nonfinite += int((~finite).sum())
         b = err.shape[0]
         sq_all = err * err
         for name, m in self._masks.items():
@@ -83,6 +91,12 @@ class CellAccumulator:
         del sq_all
         if self.tol is not None:
             self._conv.append(_convergence(err, t, self._tol))
+        self.consistency.add(t, err, P, innovation, S, scale0)
+
+    @property
+    def nonfinite(self):
+        """Number of runs added whose errors are not all finite."""
+        return self.consistency.nonfinite_runs
 
     def window_statistics(self):
         """Name → :class:`~hinfnav.metrics.WindowStatistics` (the same object the streaming Monte Carlo returns)."""
@@ -90,8 +104,8 @@ class CellAccumulator:
                                        self._per_run[name], self._max[name])
                 for name in self.windows}
 
-    def result(self):
-        """JSON-ready statistics: per window and component, per window and state group, convergence."""
+    def result(self, filter_name="filter"):
+        """JSON-ready statistics: per window and component, per window and state group, convergence, consistency."""
         st = self.state
         labels = list(st.labels) if st is not None else [f"x{i}" for i in range(self._sums[next(iter(self.windows))].size)]
         units = list(st.units) if st is not None else [""] * len(labels)
@@ -115,7 +129,8 @@ class CellAccumulator:
                     "median_s": float(np.median(c[done])) if done.any() else None}
         return {"labels": labels, "units": units,
                 "groups": {g: {"indices": list(idx), "unit": units[idx[0]]} for g, idx in groups.items()},
-                "windows": windows, "convergence": conv, "nonfinite_runs": self.nonfinite}
+                "windows": windows, "convergence": conv, "nonfinite_runs": self.nonfinite,
+                "consistency": self.consistency.result(filter_name).summary(self.windows)}
 
 
 def rms_interval(ms):

@@ -13,7 +13,11 @@ samples) with ``rms_ci95_low`` / ``rms_ci95_high`` (its 95 % interval,
 ``spread95_high`` (2.5 and 97.5 % of the runs' RMS: what one run may give),
 ``max_abs``. Per cell (window ``""``, quantity ``"all"``):
 ``convergence_median_s`` and ``convergence_fraction`` when the campaign has
-tolerances, ``nonfinite_runs``. A group's RMS is the root mean square of its
+tolerances, ``nonfinite_runs``, ``diverged`` (1 or 0) and ``diverged_runs``.
+Consistency per window (quantity ``nees`` or ``nis``, kind
+``consistency``): ``mean`` (window mean of the run-averaged statistic),
+``inside_fraction`` (steps inside the 95 % χ² bounds), ``bound_low``,
+``bound_high``, ``dof``; NaN for a filter without a covariance / without S. A group's RMS is the root mean square of its
 components' RMS (Table 1 of Sun 2011 reports position and velocity so).
 """
 
@@ -53,6 +57,19 @@ def _rows(cell):
         yield dict(rb, unit="s", statistic="convergence_median_s", value=_num(conv["median_s"]))
         yield dict(rb, unit="", statistic="convergence_fraction", value=_num(conv["fraction"]))
     yield dict(rb, unit="", statistic="nonfinite_runs", value=float(st["nonfinite_runs"]))
+    cons = st.get("consistency")
+    if cons is None:  # a cell written before the consistency statistics
+        return
+    yield dict(rb, unit="", statistic="diverged", value=float(bool(cons["diverged"])))
+    yield dict(rb, unit="", statistic="diverged_runs", value=float(cons["diverged_runs"]))
+    for wname, cw in cons["windows"].items():
+        wb = dict(base, window=wname, window_start_s=float(cw["window"][0]), window_end_s=float(cw["window"][1]),
+                  kind="consistency", unit="")
+        for key in ("nees", "nis"):
+            bounds = cons[f"{key}_bounds"] or (None, None)
+            for stat, value in (("mean", cw[key]), ("inside_fraction", cw[f"{key}_inside"]), ("bound_low", bounds[0]),
+                                ("bound_high", bounds[1]), ("dof", cons[f"{key}_dof"])):
+                yield dict(wb, quantity=key, statistic=stat, value=_num(value))
 
 
 def results_table(cells):

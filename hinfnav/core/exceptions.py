@@ -14,6 +14,7 @@ __all__ = [
     "CertificationError",
     "LooseBoundWarning",
     "SolverAccuracyWarning",
+    "FilterDivergenceWarning",
 ]
 
 
@@ -64,4 +65,15 @@ class SolverAccuracyWarning(UserWarning):
 
     The result is still certified; the message says how loose it was
     measured to be.
+    """
+
+
+class FilterDivergenceWarning(UserWarning):
+    """A filter diverged or its covariance is far from honest (issue 17, never silent).
+
+    Issued by the consistency statistics (:mod:`hinfnav.metrics.consistency`)
+    when a filter's estimation error leaves the divergence bound (non-finite,
+    or grown far beyond its initial scale) or its average NEES lies far above
+    the 95 % χ² bound; the message names the filter, the criterion and the
+    numbers.
     """

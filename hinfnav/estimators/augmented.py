@@ -41,7 +41,7 @@ _TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
 
 
 def joseph_update(P, H, R, innovation):
-    """Kalman correction (E2), batched; returns ``(δx, P⁺)``.
+    """Kalman correction (E2), batched; returns ``(δx, P⁺, S)``, S = H P Hᵀ + R the innovation covariance.
 
     ``P`` is (n, n) shared with ``H`` (m, n), or per run (runs, n, n) with
     ``H`` (m, n) or (runs, m, n).
@@ -56,7 +56,7 @@ def joseph_update(P, H, R, innovation):
         dx = (K @ innovation[..., None])[..., 0]
     I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
     P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
-    return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
+    return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2)), S
 
 
 class AugmentedEKF(Estimator):
@@ -216,14 +216,15 @@ class AugmentedEKF(Estimator):
         else:
             P = state.P
         try:
-            dx, P_post = joseph_update(P, H, self.R, innovation)
+            dx, P_post, S = joseph_update(P, H, self.R, innovation)
         except np.linalg.LinAlgError:
-            dx = P_post = np.array(np.nan)
+            dx = P_post = S = np.array(np.nan)
         if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         x_post = self.inject(x, dx)
         extra.update(self.after_update(state, x_post))
-        diag.update(innovation=innovation, input_estimate=self.augmented(x_post))
+        diag.update(innovation=innovation, input_estimate=self.augmented(x_post),
+                    innovation_covariance=self._runs(S, x.shape[0]))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         runs = x.shape[0]
         if self.output == "filtered":

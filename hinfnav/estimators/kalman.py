@@ -126,7 +126,7 @@ class ExtendedKalmanFilter(Estimator):
             x_post = x + np.einsum("rij,rj->ri", K, innovation)
         I_KH = self._I - K @ H
         P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
-        return x_post, P_post, {}
+        return x_post, P_post, {"innovation_covariance": self._broadcast(S, x.shape[0])}
 
     # -- the step contract --------------------------------------------------------
 

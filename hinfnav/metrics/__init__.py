@@ -1,5 +1,17 @@
 """Metrics layer: error statistics of simulated runs, for any state."""
 
+from .consistency import (
+    DIVERGENCE_FACTOR,
+    NEES_FACTOR,
+    NIS_KEYS,
+    ConsistencyAccumulator,
+    ConsistencyStatistics,
+    chi2_bounds,
+    consistency,
+    initial_scale,
+    normalized_squared,
+    warn_if_diverged,
+)
 from .errors import (
     MonteCarloSummary,
     axes_rms,
@@ -28,4 +40,14 @@ __all__ = [
     "monte_carlo_statistics",
     "MonteCarloStatistics",
     "WindowStatistics",
+    "chi2_bounds",
+    "normalized_squared",
+    "initial_scale",
+    "consistency",
+    "warn_if_diverged",
+    "ConsistencyAccumulator",
+    "ConsistencyStatistics",
+    "DIVERGENCE_FACTOR",
+    "NEES_FACTOR",
+    "NIS_KEYS",
 ]

@@ -8,7 +8,10 @@
 * per run, its RMS per component (``runs × n`` numbers — 48 bytes a run for a
   6-state, against ~2.8 MB a run for the histories of the paper's scenario),
   from which the Monte Carlo mean, its 95 % interval and the spread follow;
-* per run, the convergence time when tolerances are given.
+* per run, the convergence time when tolerances are given;
+* per step, the NEES and NIS summed over runs, and the divergence checks
+  (:class:`~hinfnav.metrics.consistency.ConsistencyAccumulator`); a filter
+  flagged ``diverged`` raises a :class:`~hinfnav.core.exceptions.FilterDivergenceWarning`.
 
 The numbers equal those computed from full histories up to the order of
 floating-point summation (tested).
@@ -20,6 +23,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..sim.montecarlo import simulate_batches
+from .consistency import NIS_KEYS, ConsistencyAccumulator, initial_scale, warn_if_diverged
 from .errors import window_mask
 
 __all__ = ["WindowStatistics", "MonteCarloStatistics", "monte_carlo_statistics"]
@@ -81,12 +85,19 @@ class MonteCarloStatistics:
         Per-run convergence time (NaN when a run never settles), when tolerances were given.
     state : StateSpec
     settings : dict
+    consistency : ConsistencyStatistics or None
+        Run-averaged NEES and NIS per step and the divergence counts.
+    consistency_summary : dict
+        :meth:`~hinfnav.metrics.ConsistencyStatistics.summary` over the windows
+        (``diverged``, bounds, per-window NEES/NIS and the fraction of steps inside).
     """
 
     windows: dict
     convergence_s: np.ndarray = None
     state: object = None
     settings: dict = field(default_factory=dict)
+    consistency: object = None
+    consistency_summary: dict = field(default_factory=dict)
 
     def __getitem__(self, name):
         return self.windows[name]
@@ -120,14 +131,17 @@ def monte_carlo_statistics(scenario, estimator, *, windows, runs=1, seed=0, nois
     Returns
     -------
     MonteCarloStatistics
+        With the consistency statistics; warns (:class:`~hinfnav.core.exceptions.FilterDivergenceWarning`)
+        when the filter is flagged ``diverged``.
     """
     if not isinstance(windows, dict) or not windows:
         raise InputError(f"windows must be a non-empty dict name -> (start, end) in seconds; got {windows!r}")
     sums, counts, maxima, per_run, conv = {}, {}, {}, {}, []
     masks, state, settings = None, None, {}
+    cons = ConsistencyAccumulator(runs)
     for start, res in simulate_batches(scenario, estimator, runs=runs, seed=seed, noise=noise,
                                        measurement_noise=measurement_noise, batch_size=batch_size, progress=progress,
-                                       **conditions):
+                                       diagnostics=NIS_KEYS, **conditions):
         err = res.error
         if masks is None:
             masks = {name: window_mask(res.t, w) for name, w in windows.items()}
@@ -154,11 +168,19 @@ def monte_carlo_statistics(scenario, estimator, *, windows, runs=1, seed=0, nois
             per_run[name][start:start + b] = np.sqrt(sq.mean(axis=1))
         if tol is not None:
             conv.append(_convergence(err, res.t, tol))
-        del res, err
+        P = res.P if res.P is not None and res.P.ndim == 4 else None
+        x0 = res.x[:, 0]
+        e_prior = res.state.error(x0, np.broadcast_to(np.asarray(scenario.xhat0, dtype=float), x0.shape))
+        cons.add(res.t, err, P, res.diagnostics.get(NIS_KEYS[0]), res.diagnostics.get(NIS_KEYS[1]),
+                 initial_scale(e_prior, None if P is None else P[:, 0], err[:, 0]))
+        del res, err, P
     settings["runs"] = runs
     stats = {
         name: WindowStatistics(tuple(float(v) for v in windows[name]), np.sqrt(sums[name] / counts[name]),
                                per_run[name], maxima[name])
         for name in windows
     }
-    return MonteCarloStatistics(stats, np.concatenate(conv) if conv else None, state, settings)
+    consistency = cons.result(settings.get("filter", "filter"))
+    summary = consistency.summary(windows)
+    warn_if_diverged(summary, consistency.name)
+    return MonteCarloStatistics(stats, np.concatenate(conv) if conv else None, state, settings, consistency, summary)

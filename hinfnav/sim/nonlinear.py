@@ -96,7 +96,7 @@ def run_on_truth(estimator, truth, xhat0, *, P0=None, keep_covariance=False, dia
         raise InputError(f"estimator {estimator.name!r} returned estimates of shape {hist.xhat.shape}; expected {truth.x.shape}")
     settings = dict(truth.settings, filter=estimator.name)
     return SimulationResult(t=truth.t, x=truth.x, xhat=hist.xhat, u=truth.u, y=truth.y, P=hist.P, settings=settings,
-                            state=truth.state, diagnostics=hist.diagnostics)
+                            state=truth.state, diagnostics=hist.diagnostics, xhat0=np.asarray(xhat0, dtype=float))
 
 
 def simulate_nonlinear(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
@@ -147,4 +147,4 @@ def simulate_nonlinear(scenario, estimator, *, noise="gaussian", measurement_noi
     diag = {k: np.concatenate([p.diagnostics[k] for p in parts]) for k in parts[0].diagnostics}
     settings = dict(parts[0].settings, runs=runs)
     return SimulationResult(t=parts[0].t, x=cat("x"), xhat=cat("xhat"), u=cat("u"), y=cat("y"), P=P, settings=settings,
-                            state=parts[0].state, diagnostics=diag)
+                            state=parts[0].state, diagnostics=diag, xhat0=parts[0].xhat0)

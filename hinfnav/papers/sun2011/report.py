@@ -54,7 +54,13 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         (x, y, z), ``max_pos_m``, ``max_vel_mps``, over runs ``mc_mean_pos_m``
         etc. (per-run RMS averaged, with a 95 % interval), Table 1's
         ``cell_pos_m``/``cell_vel_mps`` (run 0) and ``cell_mc_mean_*`` with
-        ``cell_mc_ci95_*``, and ``provenance``.
+        ``cell_mc_ci95_*``; the consistency over ``window_s``
+        (:mod:`hinfnav.metrics.consistency`): ``nees`` and ``nis`` (window
+        mean of the run-averaged NEES/NIS, null for a filter without a
+        covariance / without S, ``consistency_notes`` says why), their 95 %
+        χ² bounds ``nees_bounds``/``nis_bounds`` and the fraction of steps
+        inside ``nees_inside``/``nis_inside``, ``diverged`` (with
+        ``diverged_reasons``); and ``provenance``.
     """
     scenario = Scenario() if scenario is None else scenario
     runs = as_int_at_least("runs", runs, 1)
@@ -83,6 +89,8 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         return mean, [mean - half, mean + half]
 
     (mp, cp), (mv, cv) = mc(cell_p), mc(cell_v)
+    cs = stats.consistency_summary
+    cw = cs["windows"]["main"]
     return {
         "filter": label,
         "maneuver": bool(maneuver),
@@ -110,6 +118,9 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         "cell_mc_ci95_vel_mps": cv,
         "error_measure": "per-axis RMS of x - xhat over window_s, pooled over runs; cell_*: Table 1's statistic "
                          "(RMS over x, y, z of each run's per-axis RMS; run 0, and mean over runs)",
+        "nees": cw["nees"], "nees_dof": cs["nees_dof"], "nees_bounds": cs["nees_bounds"], "nees_inside": cw["nees_inside"],
+        "nis": cw["nis"], "nis_dof": cs["nis_dof"], "nis_bounds": cs["nis_bounds"], "nis_inside": cw["nis_inside"],
+        "diverged": cs["diverged"], "diverged_reasons": cs["diverged_reasons"], "consistency_notes": cs["notes"],
         "provenance": provenance(seed=int(seed), runs=int(runs)),
     }
 
@@ -135,4 +146,13 @@ def format_simulate_report(rep):
     lines.append(f"Table 1 cell: {rep['cell_pos_m']:.4g} m, {rep['cell_vel_mps']:.4g} m/s (run 0)"
                  + (f"; mean of {runs}: {rep['cell_mc_mean_pos_m']:.4g} m, {rep['cell_mc_mean_vel_mps']:.4g} m/s"
                     if runs > 1 else ""))
+    for key in ("nees", "nis"):
+        if rep.get(key) is not None:
+            lo, hi = rep[f"{key}_bounds"]
+            lines.append(f"{key.upper()} (mean over runs, dof {rep[f'{key}_dof']}): {rep[key]:.4g} over the window, "
+                         f"95 % bounds {lo:.3g}..{hi:.3g}, {100 * rep[f'{key}_inside']:.0f} % of steps inside")
+    for note in rep.get("consistency_notes", []):
+        lines.append(f"note: {note}")
+    if rep.get("diverged"):
+        lines.append("DIVERGED: " + "; ".join(rep["diverged_reasons"]))
     return "\n".join(lines)
