@@ -95,7 +95,7 @@ def test_fb01vd_one_kalman_step():
     P_next = kf.predict(posterior).P + B @ Q @ B.T
     np.testing.assert_allclose(P_next, _m("FB01VD", "P_next"), rtol=0, atol=F84)
     # the augmented filters' own correction (E2), the same step
-    dx, P_post = joseph_update(P, C, R, np.eye(2))
+    dx, P_post = joseph_update(P, C, R, np.eye(2))[:2]  # (δx, P⁺[, S])
     np.testing.assert_allclose(dx.T, _m("FB01VD", "K"), rtol=0, atol=F84)
     np.testing.assert_allclose(A @ P_post @ A.T + B @ Q @ B.T, _m("FB01VD", "P_next"), rtol=0, atol=F84)
 
