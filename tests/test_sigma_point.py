@@ -169,3 +169,21 @@ def test_weights_and_bad_parameters():
     state.P = -state.P
     with pytest.raises(HinfnavError, match="step 0"):
         ukf.update(state, np.array([[1000.0, 3.0]]))
+
+
+def test_registered_for_the_papers_that_name_it():
+    import hinfnav as hn
+    import hinfnav.papers  # noqa: F401 - registers every paper's estimators
+    from hinfnav.estimators import build_estimator, registered_estimators
+    from hinfnav.papers import shi2018, sun2011
+
+    chaser = sun2011.Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0))
+    shi = shi2018.Scenario()
+    assert "ukf" in registered_estimators(chaser) and "ukf" in registered_estimators(shi)
+    truth = hn.simulate_truth(chaser.truth_model(maneuver=True), runs=2, seed=1)
+    a = build_estimator("ukf", chaser).estimate(truth.y, truth.u, chaser.xhat0)
+    b = build_estimator("ekf_known_input", chaser).estimate(truth.y, truth.u, chaser.xhat0)
+    # linear dynamics and measurement: the unscented transform is exact, UKF = Kalman filter to rounding
+    np.testing.assert_allclose(a.xhat, b.xhat, rtol=0, atol=1e-9)
+    ukf = build_estimator("ukf", shi)
+    assert isinstance(ukf, SigmaPointFilter) and ukf.measurement.labels == ("range", "azimuth", "elevation")

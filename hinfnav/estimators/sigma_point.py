@@ -159,12 +159,12 @@ class SigmaPointFilter(Estimator):
 
     def _moments(self, X):
         """Weighted mean and deviations of state sigma points X (runs, N, n)."""
-        mean = np.einsum("i,rin->rn", self.Wm, X)
+        mean = self.Wm @ X
         return mean, X - mean[:, None, :]
 
     def _cov(self, A, B):
         """``Σ W_i^c A_i B_iᵀ`` for deviations A (runs, N, a), B (runs, N, b)."""
-        return np.einsum("i,ria,rib->rab", self.Wc, A, B)
+        return np.swapaxes(A * self.Wc[:, None], -1, -2) @ B
 
     # -- the step contract -------------------------------------------------------------
 
@@ -188,14 +188,14 @@ class SigmaPointFilter(Estimator):
         # differences of predicted outputs: the model's residual (angles wrapped), except for a converted
         # measurement, whose residual converts a reading (its predicted outputs are positions: plain differences)
         diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
-        y_mean = ref + np.einsum("i,rim->rm", self.Wm, diff(Y, ref[:, None, :]))
+        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
         dY = diff(Y, y_mean[:, None, :])
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
         S = self._cov(dY, dY) + R_k
         Pxy = self._cov(X - x[:, None, :], dY)
         K = Pxy @ inv_spd(S)
         innovation = self.measurement.residual(y, y_mean)
-        x_post = x + np.einsum("rnm,rm->rn", K, innovation)
+        x_post = x + (K @ innovation[:, :, None])[:, :, 0]
         P_post = P - K @ S @ np.swapaxes(K, -1, -2)
         P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
         diag = {"innovation": innovation, "innovation_covariance": S}
