@@ -17,10 +17,25 @@ import pytest
 from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
 from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
+import hinfnav as hn
+import hinfnav.papers  # noqa: F401 - registers every paper's estimators
 from hinfnav.core.exceptions import HinfnavError, InputError
-from hinfnav.estimators import ExtendedKalmanFilter, SigmaPointFilter
+from hinfnav.estimators import (
+    ExtendedKalmanFilter,
+    HuberFilter,
+    SigmaPointFilter,
+    build_estimator,
+    registered_estimators,
+)
 from hinfnav.estimators.sigma_point import merwe_weights
-from hinfnav.systems import ConstantTurn, ConvertedRangeBearing, LinearMeasurement, LinearSystem, RangeBearing
+from hinfnav.papers import shi2018, sun2011
+from hinfnav.systems import (
+    ConstantTurn,
+    ConvertedRangeBearing,
+    LinearMeasurement,
+    LinearSystem,
+    RangeBearing,
+)
 from hinfnav.systems.state import StateSpec
 
 DT, N_STEPS, RUNS = 1.0, 60, 2
@@ -145,7 +160,7 @@ def test_on_a_linear_model_it_is_the_kalman_filter():
 
 
 def test_converted_measurement_runs_and_uses_reading_covariance():
-    x, y = simulate(seed=8)
+    _, y = simulate(seed=8)
     conv = ConvertedRangeBearing(SENSOR)
     hist = SigmaPointFilter(MODEL, conv, P0=P0).estimate(y, np.zeros((RUNS, N_STEPS, 0)), X0, diagnostics=True)
     S = hist.diagnostics["innovation_covariance"]
@@ -155,7 +170,7 @@ def test_converted_measurement_runs_and_uses_reading_covariance():
 
 
 def test_weights_and_bad_parameters():
-    n_lam, Wm, Wc = merwe_weights(5, 0.5, 2.0, 1.0)
+    n_lam, Wm, _ = merwe_weights(5, 0.5, 2.0, 1.0)
     assert n_lam == pytest.approx(0.25 * 6)  # α²(n + κ), (U2)
     assert Wm.sum() == pytest.approx(1.0, abs=1e-14)  # the mean weights sum to one (U2)
     with pytest.raises(InputError, match="kappa"):
@@ -172,11 +187,6 @@ def test_weights_and_bad_parameters():
 
 
 def test_registered_for_the_papers_that_name_it():
-    import hinfnav as hn
-    import hinfnav.papers  # noqa: F401 - registers every paper's estimators
-    from hinfnav.estimators import build_estimator, registered_estimators
-    from hinfnav.papers import shi2018, sun2011
-
     chaser = sun2011.Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0))
     shi = shi2018.Scenario()
     assert "ukf" in registered_estimators(chaser) and "ukf" in registered_estimators(shi)
@@ -187,3 +197,13 @@ def test_registered_for_the_papers_that_name_it():
     np.testing.assert_allclose(a.xhat, b.xhat, rtol=0, atol=1e-9)
     ukf = build_estimator("ukf", shi)
     assert isinstance(ukf, SigmaPointFilter) and ukf.measurement.labels == ("range", "azimuth", "elevation")
+
+
+def test_huber_filter_accepts_a_dynamics_model():
+    # with a threshold no whitened residual reaches, Huber's M-estimation is the Kalman update (Shi & Wang 2018
+    # §1.2: ρ quadratic inside γ), so on the constant-turn problem the HBF equals the EKF
+    _, y = simulate(seed=9)
+    a, Pa = run_steps(HuberFilter(MODEL, SENSOR, P0=P0, gamma=1e6), y)
+    b, Pb = run_steps(ExtendedKalmanFilter(MODEL, SENSOR, P0=P0), y)
+    np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(Pa, Pb, rtol=1e-9, atol=1e-9)

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive, as_vector
-from .measurements import ConvertedPosition, MeasurementModel, wrap_angle
+from .measurements import ConvertedPosition, MeasurementModel, RangeAzimuthElevation
 
 __all__ = ["RangeBearing", "ConvertedRangeBearing"]
 
@@ -82,18 +82,10 @@ class RangeBearing(MeasurementModel):
         J[..., 1, i], J[..., 1, j] = -d[..., 1] / r2, d[..., 0] / r2
         return J
 
-    def residual(self, y, yhat):
-        """``y − ŷ`` with the bearing difference wrapped to (−π, π]."""
-        d = np.asarray(y, dtype=float) - np.asarray(yhat, dtype=float)
-        d = d.copy()
-        d[..., 1] = wrap_angle(d[..., 1])
-        return d
-
-    def measure(self, x, v):
-        """Noisy readings ``h(x) + v Dᵀ`` with the bearing wrapped."""
-        out = self.function(x) + np.asarray(v) @ self.D.T
-        out[..., 1] = wrap_angle(out[..., 1])
-        return out
+    # ``y − ŷ`` with the angle channels (here the bearing) wrapped to (−π, π], and noisy readings with the
+    # bearing wrapped: the 3-D sensor's, whose angles are its channels 1: as the bearing is here
+    residual = RangeAzimuthElevation.residual
+    measure = RangeAzimuthElevation.measure
 
     def inverse(self, m):
         """(P3) The position ``o + r (cos b, sin b)`` of readings (r, b), shape (..., 2), m."""

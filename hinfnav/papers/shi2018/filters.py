@@ -30,8 +30,13 @@ from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_positive
 from ...estimators.huber_filter import HuberFilter
 from ...estimators.kalman import ExtendedKalmanFilter
+from ...estimators.registry import (
+    build_estimator,
+    estimator_entry,
+    register_estimator,
+    registered_estimators,
+)
 from ...estimators.sigma_point import SigmaPointFilter
-from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 from .constants import GAMMA
 from .scenario import Scenario
 
