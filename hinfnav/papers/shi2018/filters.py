@@ -30,12 +30,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_positive
 from ...estimators.huber_filter import HuberFilter
 from ...estimators.kalman import ExtendedKalmanFilter
-from ...estimators.registry import (
-    build_estimator,
-    estimator_entry,
-    register_estimator,
-    registered_estimators,
-)
+from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
