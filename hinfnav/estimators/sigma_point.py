@@ -176,7 +176,13 @@ class SigmaPointFilter(Estimator):
     def update(self, state, y):
         x, P = state.x, state.P
         runs, n = x.shape
+        if state.extra.get("updated"):
+            raise InputError(f"filter {self.name!r}: update called twice at step {state.k}; call predict between updates")
         y = np.asarray(y, dtype=float)
+        if y.shape != (runs, self.measurement.n_meas) or not np.all(np.isfinite(y)):
+            raise InputError(f"y at step {state.k} must be finite numbers of shape ({runs}, {self.measurement.n_meas}) "
+                             f"(runs, n_meas); got shape {y.shape}" + ("" if y.size == 0 or np.all(np.isfinite(y))
+                                                                       else " with NaN or inf entries"))
         X = self._points(x, P, state.k, "prior")
         N = X.shape[1]
         try:
@@ -199,7 +205,7 @@ class SigmaPointFilter(Estimator):
         P_post = P - K @ S @ np.swapaxes(K, -1, -2)
         P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
         diag = {"innovation": innovation, "innovation_covariance": S}
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, updated=True))
         if self.output == "filtered":
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
@@ -212,8 +218,14 @@ class SigmaPointFilter(Estimator):
         N = X.shape[1]
         uu = None
         if self.uses_input:
-            uu = np.repeat(np.asarray(u, dtype=float), N, axis=0)
+            u = np.asarray(u, dtype=float)
+            if u.shape != (runs, self.n_input) or not np.all(np.isfinite(u)):
+                raise InputError(f"u at step {state.k} must be finite numbers of shape ({runs}, {self.n_input}) "
+                                 f"(runs, n_input); got shape {u.shape}" + ("" if np.all(np.isfinite(u))
+                                                                            else " with NaN or inf entries"))
+            uu = np.repeat(u, N, axis=0)
         Xf = np.asarray(self.system.f(X.reshape(runs * N, n), uu, state.k * self.dt)).reshape(runs, N, n)
         x, dX = self._moments(Xf)
         P = self._cov(dX, dX) + self.Q
-        return FilterState(x=x, P=P, k=state.k + 1, extra=dict(state.extra))
+        extra = {key: val for key, val in state.extra.items() if key != "updated"}
+        return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
