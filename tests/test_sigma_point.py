@@ -29,6 +29,9 @@ from hinfnav.estimators import (
 )
 from hinfnav.estimators.sigma_point import merwe_weights
 from hinfnav.papers import shi2018, sun2011
+from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
+from hinfnav.papers.attitude2018 import build_aekf
+from hinfnav.sim.nonlinear import simulate_nonlinear_truth
 from hinfnav.systems import (
     ConstantTurn,
     ConvertedRangeBearing,
@@ -228,3 +231,30 @@ def test_step_interface_checks_y_u_and_order():
     state, _ = lin.update(lin.start([0.0, 0.0]), np.array([[0.5]]))
     with pytest.raises(InputError, match=r"u at step 0 .*NaN or inf"):
         lin.predict(state, np.array([[np.nan]]))
+
+
+def test_quaternion_states_through_error_coordinates():
+    # (U6) on paper 002's gyroless attitude problem. Independent reference: the attitude EKF (AEKF,
+    # hinfnav.estimators.attitude). As α → 0 the unscented transform tends to the linearisation, so the UKF with
+    # α = 1e-2 must agree with the AEKF far inside the estimation error (left: O(α²) terms and the AEKF's Taylor
+    # e^{FΔt} against the Jacobian of the mean prediction); with α = 1 it must estimate as well (RMS within 1 %).
+    sc = AttitudeScenario(orbits=0.05)  # 293 steps of 1 s
+    truth = simulate_nonlinear_truth(sc.truth_model(), runs=2, seed=11)
+    aekf = build_aekf(sc)
+    ref = aekf.estimate(truth.y, truth.u, sc.xhat0)
+    spec = sc.system().state
+    rms = np.sqrt(np.mean(spec.error(truth.x, ref.xhat)[:, 150:] ** 2, axis=(0, 1)))  # per error coordinate
+    for alpha in (1e-2, 1.0):
+        ukf = SigmaPointFilter(sc.system(), sc.measurement, P0=sc.P0, Q=aekf.Qd, uses_input=True, alpha=alpha)
+        hist = ukf.estimate(truth.y, truth.u, sc.xhat0)
+        assert hist.P.shape == truth.x.shape[:2] + (9, 9)
+        np.testing.assert_allclose(np.linalg.norm(hist.xhat[..., :4], axis=-1), 1.0, atol=1e-12)  # unit quaternions
+        if alpha < 1:
+            diff = np.abs(spec.error(ref.xhat, hist.xhat)[:, 150:]).max(axis=(0, 1))
+            assert np.all(diff <= 1e-3 * rms), diff / rms
+            np.testing.assert_allclose(hist.P, ref.P, rtol=0, atol=1e-6 * np.abs(ref.P).max())
+        else:
+            ukf_rms = np.sqrt(np.mean(spec.error(truth.x, hist.xhat)[:, 150:] ** 2, axis=(0, 1)))
+            np.testing.assert_allclose(ukf_rms[:3], rms[:3], rtol=0.01)
+    with pytest.raises(InputError, match="Q .* must be given"):
+        SigmaPointFilter(sc.system(), sc.measurement, P0=sc.P0, uses_input=True)

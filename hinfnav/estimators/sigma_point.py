@@ -32,8 +32,18 @@ mean of the Y_i when nothing wraps), ``S = Σ W_i^c r(Y_i, ȳ) r(Y_i, ȳ)ᵀ + R
 The dynamics may be any model of :mod:`hinfnav.systems.dynamics` or a
 :class:`~hinfnav.systems.LinearSystem` (on which, with a linear measurement,
 the filter equals the Kalman filter: the transform is exact for linear maps).
-States with a non-additive error (quaternion attitude states) are refused:
-their error-coordinate sigma points are not implemented yet.
+
+**Quaternion states** (a state spec with its own ``error``, e.g.
+:class:`~hinfnav.systems.attitude.AttitudeSystem`'s ``[q, ω, T]``): the
+sigma points and P live in the error coordinates (δθ, δω, δT) (dimension
+``state.n``, 9), as in the attitude EKF (Lefferts, Markley & Shuster 1982):
+``χ_i = x̂ ⊞ δ_i`` with the system's ``inject`` (``q ← δq(δθ) ⊗ q``), the
+propagated points are compared with the propagated centre χ⁻₀ by the inverse
+map ``χ ⊟ χ⁻₀ = (rotvec(q ⊗ q₀⁻¹), ω − ω₀, T − T₀)``, and
+``x̂⁻ = χ⁻₀ ⊞ Σ W_i^m (χ⁻_i ⊟ χ⁻₀)``, ``P⁻ = Σ W_i^c (d_i − d̄)(d_i − d̄)ᵀ + Q``
+(U6) (a USQUE-type filter, Crassidis & Markley, JGCD 26(4), 2003, with the
+rotation vector as attitude error). Q must then be given, per step, in error
+coordinates (e.g. ``Δt Γ Q_c Γᵀ``).
 
 Diagnostics at each step: ``innovation`` ν (runs, m) and
 ``innovation_covariance`` S (runs, m, m).
@@ -44,6 +54,7 @@ import numpy as np
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, inv_spd
 from ..core.validation import as_choice, as_nonnegative, as_positive, as_real, as_vector
+from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput
 from .kalman import OUTPUTS, ExtendedKalmanFilter
@@ -111,14 +122,19 @@ class SigmaPointFilter(Estimator):
     def __init__(self, system, measurement, *, P0, Q=None, R=None, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0,
                  uses_input=False, output="filtered", name=None):
         super().__init__(system, measurement, name=name)
-        if not hasattr(system, "f"):
+        #: True for a state with its own error (a quaternion): sigma points in error coordinates (U6)
+        self.error_coordinates = type(system.state).error is not StateSpec.error
+        if self.error_coordinates:
+            if not (hasattr(system, "inject") and hasattr(system, "predict_mean")):
+                raise InputError(f"the state of this system ({type(system.state).__name__}) has its own error: the "
+                                 "system must give inject(x, dx) and predict_mean(x, u) (as AttitudeSystem does)")
+            if Q is None:
+                raise InputError("Q (process noise per step, in error coordinates) must be given for this system")
+        elif not hasattr(system, "f"):
             raise InputError(f"system must be a dynamics model with f(x, u, t) (or a LinearSystem); "
                              f"got {type(system).__name__}")
-        if type(system.state).error is not StateSpec.error:
-            raise InputError(f"the sigma-point filter handles additive-error states only; the state of this system "
-                             f"({type(system.state).__name__}) has its own error (e.g. a quaternion), which is not "
-                             "supported yet")
-        n, m = system.n, measurement.n_meas
+        n, m = system.state.n, measurement.n_meas  # n: the error coordinates (the covariance's dimension)
+        self.n_cov = n
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
         self.R_of_reading = getattr(measurement, "noise_covariance", None) if R is None else None
         self.R = (None if self.R_of_reading is not None
@@ -150,9 +166,10 @@ class SigmaPointFilter(Estimator):
 
     # -- the transform -------------------------------------------------------------
 
-    def _points(self, x, P, k, what):
+    def _points(self, P, k, what):
+        """Sigma-point offsets (runs, N, n_cov) of covariances P: (U1)/(U3) about zero."""
         try:
-            return sigma_points(x, P, self.scale, center=self.rule == "unscented")
+            return sigma_points(np.zeros(P.shape[:-1]), P, self.scale, center=self.rule == "unscented")
         except np.linalg.LinAlgError:
             raise HinfnavError(f"filter {self.name!r} stopped at step {k}: the {what} covariance is not positive "
                                "definite (no sigma points)") from None
@@ -162,6 +179,23 @@ class SigmaPointFilter(Estimator):
         mean = self.Wm @ X
         return mean, X - mean[:, None, :]
 
+    def _inject(self, x, dx):
+        """``x ⊞ δx``: x + δx, or the system's injection (``q ← δq(δθ) ⊗ q``, the rest added)."""
+        return x + dx if not self.error_coordinates else self.system.inject(np.broadcast_to(x, dx.shape[:-1] + x.shape[-1:]), dx)
+
+    def _difference(self, x, ref):
+        """``x ⊟ ref``, the inverse of :meth:`_inject`: x − ref, or (U6) for a quaternion-first state."""
+        if not self.error_coordinates:
+            return x - ref
+        ref = np.broadcast_to(ref, x.shape)
+        dq = quat_multiply(x[..., :4], quat_conjugate(ref[..., :4]))
+        return np.concatenate([rotvec_from_quat(dq), x[..., 4:] - ref[..., 4:]], axis=-1)
+
+    def _propagate(self, X, u, t):
+        if self.error_coordinates:
+            return np.asarray(self.system.predict_mean(X, u))
+        return np.asarray(self.system.f(X, u, t))
+
     def _cov(self, A, B):
         """``Σ W_i^c A_i B_iᵀ`` for deviations A (runs, N, a), B (runs, N, b)."""
         return np.swapaxes(A * self.Wc[:, None], -1, -2) @ B
@@ -169,8 +203,10 @@ class SigmaPointFilter(Estimator):
     # -- the step contract -------------------------------------------------------------
 
     def start(self, xhat0, P0=None, runs=1):
-        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
+        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
         x = np.broadcast_to(as_vector("xhat0", xhat0, self.n_state), (runs, self.n_state)).copy()
+        if self.error_coordinates:  # the system's injection of a zero correction normalises (a unit quaternion)
+            x = self._inject(x, np.zeros((runs, self.n_cov)))
         return FilterState(x=x, P=np.broadcast_to(P, (runs,) + P.shape).copy())
 
     def update(self, state, y):
@@ -183,7 +219,8 @@ class SigmaPointFilter(Estimator):
             raise InputError(f"y at step {state.k} must be finite numbers of shape ({runs}, {self.measurement.n_meas}) "
                              f"(runs, n_meas); got shape {y.shape}" + ("" if y.size == 0 or np.all(np.isfinite(y))
                                                                        else " with NaN or inf entries"))
-        X = self._points(x, P, state.k, "prior")
+        dX = self._points(P, state.k, "prior")
+        X = self._inject(x[:, None, :], dX)
         N = X.shape[1]
         try:
             Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
@@ -198,10 +235,10 @@ class SigmaPointFilter(Estimator):
         dY = diff(Y, y_mean[:, None, :])
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
         S = self._cov(dY, dY) + R_k
-        Pxy = self._cov(X - x[:, None, :], dY)
+        Pxy = self._cov(dX, dY)
         K = Pxy @ inv_spd(S)
         innovation = self.measurement.residual(y, y_mean)
-        x_post = x + (K @ innovation[:, :, None])[:, :, 0]
+        x_post = self._inject(x, (K @ innovation[:, :, None])[:, :, 0])
         P_post = P - K @ S @ np.swapaxes(K, -1, -2)
         P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
         diag = {"innovation": innovation, "innovation_covariance": S}
@@ -214,7 +251,7 @@ class SigmaPointFilter(Estimator):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         runs, n = state.x.shape
-        X = self._points(state.x, state.P, state.k, "posterior")
+        X = self._inject(state.x[:, None, :], self._points(state.P, state.k, "posterior"))
         N = X.shape[1]
         uu = None
         if self.uses_input:
@@ -224,8 +261,15 @@ class SigmaPointFilter(Estimator):
                                  f"(runs, n_input); got shape {u.shape}" + ("" if np.all(np.isfinite(u))
                                                                             else " with NaN or inf entries"))
             uu = np.repeat(u, N, axis=0)
-        Xf = np.asarray(self.system.f(X.reshape(runs * N, n), uu, state.k * self.dt)).reshape(runs, N, n)
-        x, dX = self._moments(Xf)
+        t = state.k * self.dt
+        Xf = self._propagate(X.reshape(runs * N, n), uu, t).reshape(runs, N, n)
+        if not self.error_coordinates:
+            x, dX = self._moments(Xf)
+        else:  # (U6): deviations about the propagated centre, their weighted mean injected
+            ref = Xf[:, 0] if self.rule == "unscented" else self._propagate(state.x, u, t)
+            D = self._difference(Xf, ref[:, None, :])
+            mean = self.Wm @ D
+            x, dX = self._inject(ref, mean), D - mean[:, None, :]
         P = self._cov(dX, dX) + self.Q
         extra = {key: val for key, val in state.extra.items() if key != "updated"}
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
