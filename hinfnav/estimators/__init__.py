@@ -13,6 +13,7 @@ from .huber_filter import HuberFilter
 from .recursive_hinf import RecursiveHInfinityFilter
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 from .lti import LTIFilter
+from .sigma_point import SigmaPointFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "SaturatedExtendedStateFilter",
     "FusedExtendedStateFilter",
     "RecursiveHInfinityFilter",
+    "SigmaPointFilter",
     "StrongTracking",
     "RateAdaptive",
     "AugmentedEKF",

@@ -39,8 +39,12 @@ class ExtendedKalmanFilter(Estimator):
 
     Parameters
     ----------
-    system : LinearSystem
-        Φ, Γ, B (Q = B Bᵀ by default), dt, state labels.
+    system : LinearSystem or dynamics model
+        Φ, Γ, B (Q = B Bᵀ by default), dt, state labels; or a nonlinear
+        dynamics model (:mod:`hinfnav.systems.dynamics`, ``linear`` False):
+        the mean is propagated by its ``f`` and P by ``F P Fᵀ + Q`` with F its
+        Jacobian at the posterior estimate (the hooks ``predict_mean`` and
+        ``predict_covariance`` are those of a linear system).
     measurement : MeasurementModel
         h, its Jacobian, R = D Dᵀ by default, residual (angles wrapped).
     P0 : array_like, shape (n, n)
@@ -78,14 +82,16 @@ class ExtendedKalmanFilter(Estimator):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
         self.uses_input = bool(uses_input)
         self.output = as_choice("output", output, OUTPUTS)
-        self.F = system.Phi
-        self.Gamma = system.Gamma
+        #: a nonlinear dynamics model (``linear`` False, see hinfnav.systems.dynamics): f and its Jacobian per run
+        self.nonlinear_dynamics = not getattr(system, "linear", True)
+        self.F = None if self.nonlinear_dynamics else system.Phi
+        self.Gamma = None if self.nonlinear_dynamics else system.Gamma
         self._I = np.eye(n)
 
     @property
     def shares_covariance(self):
         """True when P and the gain do not depend on the data (linear measurement, constant R)."""
-        return bool(self.measurement.linear) and self.R_of_reading is None
+        return bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
 
     # -- hooks ------------------------------------------------------------------
 
@@ -161,8 +167,14 @@ class ExtendedKalmanFilter(Estimator):
     def predict(self, state, u=None):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        x = self.predict_mean(state.x, None if u is None else np.asarray(u, dtype=float))
-        P = self.predict_covariance(state.P, state)
+        u = None if u is None else np.asarray(u, dtype=float)
+        if self.nonlinear_dynamics:  # x̂⁻ = f(x̂, u, t_k), P⁻ = F P Fᵀ + Q with F = ∂f/∂x at x̂ (per run)
+            args = (state.x, u if self.uses_input else None, state.k * self.dt)
+            x = self.system.f(*args)
+            P = congruence(self.system.jacobian(*args), state.P) + self.Q
+        else:
+            x = self.predict_mean(state.x, u)
+            P = self.predict_covariance(state.P, state)
         extra = {key: val for key, val in state.extra.items() if key != "prior"}
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 

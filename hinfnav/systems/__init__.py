@@ -14,6 +14,7 @@ from .hill import (
     uncertainty_F,
     uncertainty_structure,
 )
+from .dynamics import ConstantTurn, ContinuousDynamics, DiscreteDynamics, DynamicsModel, constant_turn_state_spec
 from .linear import LinearSystem
 from .measurements import (
     LinearMeasurement,
@@ -26,6 +27,7 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .planar import ConvertedRangeBearing, RangeBearing
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 
@@ -33,10 +35,17 @@ __all__ = [
     "StateSpec",
     "chaser_state_spec",
     "LinearSystem",
+    "DynamicsModel",
+    "DiscreteDynamics",
+    "ContinuousDynamics",
+    "ConstantTurn",
+    "constant_turn_state_spec",
     "MeasurementModel",
     "LinearMeasurement",
     "RangeAzimuthElevation",
     "Saturated",
+    "RangeBearing",
+    "ConvertedRangeBearing",
     "as_measurement_model",
     "range_angles",
     "range_angles_jacobian",

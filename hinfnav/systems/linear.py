@@ -47,6 +47,9 @@ class LinearSystem:
     name: str = "linear system"
     info: dict = field(default_factory=dict)
 
+    #: The dynamics-model protocol (:mod:`hinfnav.systems.dynamics`): f is linear, its Jacobian is Φ.
+    linear = True
+
     def __post_init__(self):
         Phi = as_matrix("Phi", self.Phi)
         n = Phi.shape[0]
@@ -96,6 +99,14 @@ class LinearSystem:
             return self.Phi
         K = as_matrix("K", K, (self.n_input, self.n))
         return self.Phi + self.Gamma @ K
+
+    def f(self, x, u=None, t=0.0):
+        """The dynamics-model protocol: ``x Φᵀ (+ u Γᵀ)`` for a batch (rows are runs); t is not used."""
+        return self.propagate(x, u)
+
+    def jacobian(self, x=None, u=None, t=0.0):
+        """The dynamics-model protocol: ``∂f/∂x = Φ``, shape (n, n), whatever x."""
+        return self.Phi
 
     def propagate(self, x, u=None, w=None):
         """One step for a batch: ``x Φᵀ + u Γᵀ + w Bᵀ`` (rows are runs)."""

@@ -98,6 +98,8 @@ _WHY_NOT = {
                 "lumped disturbance states, ADRC loop); no other scenario has those states or readings",
     "hbf": "the Huber update needs a registered Kalman filter of the scenario to robustify (or a scenario with "
            "truth_model, xhat0 and P0); this scenario offers neither",
+    "ukf": "the sigma-point filter is built as the unscented version of a registered Kalman filter of the scenario "
+           "(Sun 2011's ekf_known_input, Shi 2018's EKF); this scenario has none registered",
 }
 
 
@@ -108,7 +110,7 @@ def _family(name):
         return "augmented_thrust"
     if name.startswith("yang2020"):
         return "yang2020"
-    if name in ("hbf", "ekf_converted"):
+    if name in ("hbf", "ekf_converted", "ukf"):
         return name
     return "sun2011"
 

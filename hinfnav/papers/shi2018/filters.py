@@ -11,6 +11,11 @@ name               estimator
                    update (:class:`hinfnav.estimators.HuberFilter`). Fits any
                    scenario that has a Kalman filter to robustify (see
                    :func:`build_hbf`), e.g. Sun 2011's chaser
+``ukf``            the unscented (sigma-point) Kalman filter that papers 000
+                   and 001 name as the usual alternative to the EKF
+                   (:class:`hinfnav.estimators.SigmaPointFilter`): here on the
+                   direct range/angle readings; on other papers' scenarios the
+                   sigma-point version of their Kalman filter (see :func:`build_ukf`)
 =================  ==========================================================
 
 Both filters know the true Q and the true sensor errors unless told others
@@ -26,10 +31,11 @@ from ...core.validation import as_choice, as_positive
 from ...estimators.huber_filter import HuberFilter
 from ...estimators.kalman import ExtendedKalmanFilter
 from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
+from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
 
-__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "HBF_BASES"]
+__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "build_ukf", "HBF_BASES"]
 
 #: How the filters use the readings: converted to position (the paper's indirect measurement) or directly.
 MEASUREMENTS = ("converted", "direct")
@@ -139,6 +145,40 @@ def build_hbf(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, base=None, **opt
                        gamma=gamma, tol=tol, max_iter=max_iter, uses_input=True, name="hbf", **options)
 
 
+def _fits_ukf(scenario):
+    return isinstance(scenario, Scenario) or _base_name(scenario) is not None
+
+
+def build_ukf(scenario, *, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0, base=None, **options):
+    """The registry's ``ukf``: the sigma-point version of a scenario's Kalman filter.
+
+    * Shi & Wang (2018)'s scenario: :func:`EKF` with ``measurement="direct"``
+      by default (the range/angle readings themselves; on the converted,
+      linear measurement the unscented transform is exact and the filter
+      would be the EKF), its Q, R and P₀.
+    * a scenario with a registered Kalman filter (``base``, default the first
+      of :data:`HBF_BASES` that fits, e.g. Sun 2011's ``ekf_known_input``):
+      that filter's model, Q, R, P₀ and input use. On Sun 2011's chaser
+      (linear dynamics, Cartesian position (8)) it equals that Kalman filter
+      to rounding: the comparison the paper names, answered.
+
+    ``rule``, ``alpha``, ``beta``, ``kappa``: of
+    :class:`~hinfnav.estimators.SigmaPointFilter`; ``options`` go to the
+    Kalman filter's builder.
+    """
+    points = {"rule": rule, "alpha": alpha, "beta": beta, "kappa": kappa}
+    if isinstance(scenario, Scenario):
+        if base is not None:
+            raise InputError("base applies only to scenarios of other papers")
+        options.setdefault("measurement", "direct")
+        return SigmaPointFilter.from_ekf(EKF(scenario, **options), name="ukf", **points)
+    base = _base_name(scenario) if base is None else base
+    if base is None:
+        raise InputError(f"ukf needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}); "
+                         f"{type(scenario).__name__} has none")
+    return SigmaPointFilter.from_ekf(build_estimator(base, scenario, **options), name="ukf", **points)
+
+
 def _build_ekf(scenario, **options):
     return EKF(scenario, **options)
 
@@ -146,6 +186,9 @@ def _build_ekf(scenario, **options):
 register_estimator("hbf", build_hbf, fits=_fits_hbf,
                    description="Huber-based filter (Karlgaard & Schaub 2007; Shi & Wang 2018): the scenario's Kalman "
                                "filter with Huber's M-estimation as its update")
+register_estimator("ukf", build_ukf, fits=_fits_ukf,
+                   description="unscented (sigma-point) Kalman filter, the alternative to the EKF that Sun 2011 and "
+                               "Shi & Wang 2018 name: the scenario's Kalman filter with the unscented transform")
 register_estimator("ekf_converted", _build_ekf, fits=lambda scenario: isinstance(scenario, Scenario),
                    description="EKF on the converted (indirect) position measurement, R_k = J R J^T "
                                "(Shi & Wang 2018's comparison)")
