@@ -176,11 +176,11 @@ def test_validation_tries_each_value_once_not_every_grid_point(monkeypatch):
     monkeypatch.setattr(Scenario, "truth_model", counted)
     # 2 000 grid points: 40 δ × 50 masses (settings); a product of keys is tried value by value
     spec = _spec(delta=list(np.linspace(0.0, 1.0, 40)), mass=list(np.linspace(400.0, 600.0, 50)))
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: the machine running the tests may be shared
     assert len(spec.cells()) == 2000
     # first settings: every δ (40); each other mass: its first δ (49). Before issue 22: 2 000 (one per point)
     assert calls["n"] == 40 + 49
-    assert time.perf_counter() - start < 5.0
+    assert time.process_time() - start < 5.0
 
 
 def test_every_spec_error_is_found_before_any_cell_runs(tmp_path, capsys):

@@ -118,6 +118,7 @@ def run_unit(unit):
     """
     for module in unit["modules"]:
         importlib.import_module(module)
+    _BUILT.update(unit.get("built", {}))  # the estimators built (and designed) once by the validation
     t_start, c_start = time.perf_counter(), time.process_time()
     scenario = _scenario(unit["scenario"], unit["settings"])
     model = scenario.truth_model(**unit["conditions"])
@@ -404,6 +405,10 @@ def _run_locked(campaign, cells, client, out, progress, workers, connect_timeout
             for unit in units:
                 collect(run_unit(unit))
         elif units:
+            for unit in units:  # ship the estimators the validation built: no worker designs them again
+                keys = {_key("estimator", unit["scenario"], unit["settings"], c["estimator"], c["options"])
+                        for c in unit["cells"]}
+                unit["built"] = {k: _BUILT[k] for k in keys if k in _BUILT}
             _run_distributed(units, client, workers, connect_timeout, collect)
     finally:
         bar.close()
