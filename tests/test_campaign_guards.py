@@ -112,7 +112,7 @@ def test_folder_holding_another_spec_is_refused_naming_both(tmp_path):
         run_campaign(_spec(runs=3), client="serial", out_dir=out, progress=False)
     with pytest.raises(InputError, match=r"grid\.delta: None there, \[0\.0, 1\.0\] here"):
         run_campaign(_spec(runs=2, delta=[0.0, 1.0]), client="serial", out_dir=out, progress=False)
-    # the folder still says what it holds, and the same spec resumes (one number in JSON: 2 and 2.0 are one value)
+    # the refused runs touched nothing: the folder still says what it holds, and the same spec resumes it
     assert json.loads((out / "campaign.json").read_text())["spec"]["runs"] == 2
     assert run_campaign(_spec(runs=2), client="serial", out_dir=out, progress=False).attrs["reused"] == 1
 
