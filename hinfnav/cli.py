@@ -101,14 +101,29 @@ def _cmd_campaign(args):
     from .papers.benchmark import load_papers
 
     load_papers()  # every paper's scenarios and estimators, so that SPEC may name any of them
-    table = run_campaign(args.spec, client=args.scheduler, out_dir=args.out, progress=True, workers=args.workers)
+    table = run_campaign(args.spec, client=args.scheduler, out_dir=args.out, progress=True, workers=args.workers,
+                         limits=dict(args.limit))
     info = table.attrs
     print(f"{len(info['cells'])} cells ({info['computed']} computed, {info['reused']} reused); "
           f"table: {info['out_dir']}/results.csv")
     for cell_id, message in info["errors"].items():
         print(f"error: cell {cell_id}: {message}", file=sys.stderr)
-    if info["errors"]:
-        raise HinfnavError(f"{len(info['errors'])} cells failed (see above); run the command again to retry them")
+    if info["errors"]:  # the spec was checked whole before any work: these failed while running
+        raise HinfnavError(f"{len(info['errors'])} cells failed while running (see above); the finished cells are "
+                           "kept, and running the command again computes only the failed ones (which helps only if "
+                           "the failure was transient, e.g. a lost worker)")
+
+
+def _limit(text):
+    """``--limit NAME=VALUE`` → ``(NAME, VALUE)``; argparse reports a malformed one."""
+    name, sep, value = text.partition("=")
+    try:
+        number = float(value)
+    except ValueError:
+        number = float("nan")
+    if not sep or not name.strip() or not (math.isfinite(number) and number > 0):
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with a number VALUE > 0 (e.g. runs=10000000); got {text!r}")
+    return name.strip(), int(number) if number.is_integer() else number
 
 
 def _parser():
@@ -174,6 +189,9 @@ def _parser():
                         "machine; 'serial': in this process")
     c.add_argument("--workers", type=int, default=None, metavar="N",
                    help="worker processes of the LocalCluster (default: one per core)")
+    c.add_argument("--limit", action="append", default=[], type=_limit, metavar="NAME=VALUE",
+                   help="raise a stated maximum checked before any work (runs, cells, steps, batch_bytes; see "
+                        "hinfnav.campaign.spec.LIMITS), e.g. --limit runs=10000000; repeatable")
     c.set_defaults(func=_cmd_campaign)
     return p
 

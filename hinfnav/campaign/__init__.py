@@ -31,6 +31,7 @@ _EXPORTS = {
     "load_campaign": "spec",
     "canonical": "spec",
     "digest": "spec",
+    "LIMITS": "spec",
     "CellAccumulator": "stats",
     "group_summary": "stats",
     "rms_interval": "stats",

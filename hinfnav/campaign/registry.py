@@ -9,9 +9,8 @@ campaign grid may vary; the parameters of the scenario's
 
 import inspect
 from dataclasses import dataclass
-from importlib import metadata
-
 from ..core.exceptions import InputError
+from ..estimators.registry import PROVIDER_GROUP, load_providers, providers
 
 __all__ = ["register_scenario", "registered_scenarios", "scenario_entry", "build_scenario", "scenario_parameters",
            "condition_parameters", "load_providers", "providers", "PROVIDER_GROUP"]
@@ -50,29 +49,6 @@ def register_scenario(name, factory, *, description=""):
 def registered_scenarios():
     """Names of the registered scenarios, in registration order."""
     return tuple(_SCENARIOS)
-
-
-#: Entry-point group of the modules that register scenarios and estimators when imported. This
-#: package declares its papers (``hinfnav.papers``) in ``pyproject.toml``; another installed package
-#: may declare its own. They are loaded on the first unknown name, as a plugin host loads its plugins:
-#: the campaign layer never imports them by name (they sit above it).
-PROVIDER_GROUP = "hinfnav.providers"
-
-
-def providers():
-    """The provider modules declared under :data:`PROVIDER_GROUP` by the installed packages."""
-    return tuple(ep.value for ep in metadata.entry_points(group=PROVIDER_GROUP))
-
-
-def load_providers():
-    """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
-    failed = {}
-    for ep in metadata.entry_points(group=PROVIDER_GROUP):
-        try:
-            ep.load()
-        except ImportError as exc:  # pragma: no cover - a provider under construction
-            failed[ep.value] = str(exc)
-    return failed
 
 
 def scenario_entry(name, field="scenario"):

@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ..core.exceptions import InputError
-from ..core.outputs import MARKER, check_output_dir, to_json
+from ..core.exceptions import HinfnavError, InputError
+from ..core.outputs import MARKER, check_output_dir, output_lock, to_json
 from ..core.progress import bar_disabled
 from ..core.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
@@ -130,6 +130,7 @@ def run_unit(unit):
     """
     for module in unit["modules"]:
         importlib.import_module(module)
+    _BUILT.update(unit.get("built", {}))  # the estimators built (and designed) once by the validation
     t_start, c_start = time.perf_counter(), time.process_time()
     scenario = _scenario(unit["scenario"], unit["settings"])
     model = scenario.truth_model(**unit["conditions"])
@@ -287,19 +288,70 @@ def _close(dask_client):
         cluster.close()
 
 
-def _prepare_out(out_dir, campaign):
-    out = check_output_dir(out_dir, "out_dir")
-    (out / "cells").mkdir(parents=True, exist_ok=True)
-    if not (out / MARKER).exists():
-        (out / MARKER).write_text("written by hinfnav: a campaign folder; finished cells are kept and reused\n")
-    _atomic_write(out / "campaign.json", json.dumps(_clean({"spec": campaign.as_dict(),
-                                                             "cells": [c.cell_id for c in campaign.cells()]}),
-                                                    indent=2) + "\n")
+def _differences(old, new):
+    """Fields in which two spec dicts (``Campaign.as_dict``) differ, as ``field: old → new`` strings."""
+    same = lambda a, b: canonical(a) == canonical(b)  # noqa: E731 - 1 and 1.0 are one value
+    out = []
+    for key in sorted(set(old) | set(new)):
+        a, b = old.get(key), new.get(key)
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += [f"{key}.{k}: {a.get(k)!r} there, {b.get(k)!r} here" for k in sorted(set(a) | set(b))
+                    if not same(a.get(k), b.get(k))]
+        elif not same(a, b):
+            out.append(f"{key}: {a!r} there, {b!r} here")
     return out
 
 
-def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None, connect_timeout=5.0):
+def _prepare_out(out, campaign):
+    """Make the campaign folder ready (the caller holds its lock): same spec or none, no orphan temporary files."""
+    meta = {"spec": _clean(campaign.as_dict()), "cells": [c.cell_id for c in campaign.cells()]}
+    meta = json.loads(json.dumps(meta))  # what campaign.json will hold, to compare like with like
+    try:
+        old = json.loads((out / "campaign.json").read_text())["spec"]
+    except (OSError, ValueError, KeyError, TypeError):
+        old = None
+    if old is not None and canonical(old) != canonical(meta["spec"]):
+        diff = _differences(old, meta["spec"])
+        raise InputError(f"out_dir {out} holds another campaign ({old.get('name')!r}; this spec is "
+                         f"{campaign.name!r}); they differ in {'; '.join(diff)}. Choose another folder, or delete "
+                         "this one to start over")
+    (out / "cells").mkdir(parents=True, exist_ok=True)
+    for orphan in [*(out / "cells").glob(".*.tmp"), *out.glob(".*.tmp")]:  # writes of a killed run
+        orphan.unlink(missing_ok=True)
+    if not (out / MARKER).exists():
+        (out / MARKER).write_text("written by hinfnav: a campaign folder; finished cells are kept and reused\n")
+    _atomic_write(out / "campaign.json", json.dumps(meta, indent=2) + "\n")
+    return out
+
+
+def _check_estimators(campaign):
+    """Build every estimator once on every validated scenario (cached): bad options, a filter for another dt…"""
+    for scenario_name, settings, scenario, names in campaign.tried():
+        for est in names:
+            options = campaign.estimator_options.get(est, {})
+            try:
+                _estimator(scenario, scenario_name, settings, est, options)
+            except (HinfnavError, TypeError, ValueError) as exc:
+                field = f"estimator_options.{est}" if options else f"grid.estimator ({est!r})"
+                where = ", ".join([f"scenario = {scenario_name!r}"] + [f"{k} = {v!r}" for k, v in settings.items()])
+                raise InputError(f"{field}: cannot build {est!r} for {where}: {exc}") from None
+
+
+def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None, connect_timeout=5.0, limits=None):
     """Run a campaign on Dask and return its tidy results table.
+
+    With the default LocalCluster, a script must call it under ``if __name__ == "__main__":`` (Dask starts its
+    worker processes by re-importing the script, which without the guard would start the campaign again)::
+
+        import hinfnav as hn
+
+        if __name__ == "__main__":
+            table = hn.run_campaign("benchmarks/campaign_example.toml", out_dir="results/example")
+
+    Before any work the spec is checked whole (:meth:`hinfnav.campaign.spec.Campaign.cells`: limits, names,
+    values; then every estimator is built once on every validated scenario), and ``out_dir`` is locked (an
+    OS-level lock beside it: a second process into the same folder is refused) and must hold no campaign
+    or this one (a folder holding another spec is refused, naming what differs).
 
     Parameters
     ----------
@@ -320,6 +372,9 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
         Worker processes of the LocalCluster (only with ``client=None``).
     connect_timeout : float
         Seconds to wait for a scheduler address before giving up.
+    limits : dict, optional
+        Overrides of the stated maxima :data:`hinfnav.campaign.spec.LIMITS` (``runs``, ``cells``, ``steps``,
+        ``batch_bytes``), e.g. ``{"runs": 10**7}``.
 
     Returns
     -------
@@ -331,7 +386,8 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
         results, in grid order).
     """
     campaign = load_campaign(spec)
-    cells = campaign.cells()  # validates every name and value before any work
+    cells = campaign.cells(limits)  # limits, names and values, before any work
+    _check_estimators(campaign)
     if workers is not None:
         if client is not None:
             raise InputError(f"workers applies to the LocalCluster that run_campaign starts (client=None) only; "
@@ -340,7 +396,14 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
             raise InputError(f"workers must be an integer >= 1; got {workers!r}")
     if not (isinstance(connect_timeout, (int, float)) and connect_timeout > 0):
         raise InputError(f"connect_timeout must be a number of seconds > 0; got {connect_timeout!r}")
-    out = _prepare_out(out_dir, campaign) if out_dir is not None else None
+    out = check_output_dir(out_dir, "out_dir") if out_dir is not None else None
+    with output_lock(out, "out_dir") if out is not None else contextlib.nullcontext():
+        return _run_locked(campaign, cells, client, out, progress, workers, connect_timeout)
+
+
+def _run_locked(campaign, cells, client, out, progress, workers, connect_timeout):
+    if out is not None:
+        _prepare_out(out, campaign)
     results = {}
     if out is not None:
         for cell in cells:
@@ -373,6 +436,10 @@ def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None
             for unit in units:
                 collect(run_unit(unit))
         elif units:
+            for unit in units:  # ship the estimators the validation built: no worker designs them again
+                keys = {_key("estimator", unit["scenario"], unit["settings"], c["estimator"], c["options"])
+                        for c in unit["cells"]}
+                unit["built"] = {k: _BUILT[k] for k in keys if k in _BUILT}
             _run_distributed(units, client, workers, connect_timeout, collect)
     finally:
         bar.close()

@@ -33,6 +33,19 @@ have less Monte Carlo noise), and a cell's numbers do not depend on which
 other cells the grid holds. A cell's identity (the name of its result file)
 hashes everything that determines its numbers: those parameters, the
 estimator and its options, runs, batch size, windows and tolerances.
+
+Limits and validation, before any work. :meth:`Campaign.cells` first checks
+the counts against :data:`LIMITS` (runs per cell, cells), from the grid's
+lengths alone, then validates the grid without building every grid point:
+each scenario setting value is tried once (and each condition value once, on
+the first settings), with the other keys at their first value; a group of keys
+with at most :data:`FULL_CHECK` combinations is tried in full. Then the
+estimated work and memory (:meth:`Campaign.estimate`) are checked against
+:data:`LIMITS`. A combination of two non-first values that only fails together
+is not seen before work (its cell is reported with ``status="error"``). The
+runner also builds each estimator once per tried settings
+(:func:`hinfnav.campaign.runner.run_campaign`), so bad estimator options or a
+filter made for another sampling time are refused before any cell runs.
 """
 
 import hashlib
@@ -47,14 +60,30 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from ..estimators.registry import estimator_entry, registered_estimators
 from ..noise import NOISE_NAMES
-from .registry import build_scenario, condition_parameters, load_providers, scenario_entry, scenario_parameters
+from .registry import build_scenario, condition_parameters, scenario_entry, scenario_parameters
 
-__all__ = ["Campaign", "Cell", "load_campaign", "canonical", "digest"]
+__all__ = ["Campaign", "Cell", "load_campaign", "canonical", "digest", "LIMITS", "FULL_CHECK", "STEPS_PER_SECOND"]
 
 #: Top-level fields of a campaign (TOML or dict).
 FIELDS = ("name", "runs", "seed", "batch_size", "grid", "windows", "tol", "estimator_options", "share_truth")
 #: Grid keys with a meaning of their own (all others are scenario settings or conditions).
 RESERVED = ("scenario", "estimator", "noise")
+
+#: Stated maxima, checked before any work (override one with ``run_campaign(..., limits={"runs": 10**7})`` or
+#: ``python -m hinfnav campaign ... --limit runs=10000000``):
+#:
+#: * ``runs``: Monte Carlo runs per cell (as ``simulate --runs``);
+#: * ``cells``: cells of the grid (grid points × estimators);
+#: * ``steps``: estimator steps of the whole campaign, cells × runs × time steps: the time estimate, at about
+#:   :data:`STEPS_PER_SECOND` per core (1e11 ≈ a day on two cores);
+#: * ``batch_bytes``: estimated memory of one batch of runs in a worker (truth, measurements, estimates, errors).
+LIMITS = {"runs": 1_000_000, "cells": 20_000, "steps": 1e11, "batch_bytes": 2 * 2**30}
+#: Estimator steps per second and core, measured on the cross-paper benchmark (312 cells × 200 runs × 10⁴ steps,
+#: ~9 min on 2 cores: ``python -m hinfnav reproduce --paper benchmark``); for the time estimate only.
+STEPS_PER_SECOND = 6e5
+#: A group of grid keys (settings, or conditions) with at most this many combinations is validated in full;
+#: a larger one value by value.
+FULL_CHECK = 32
 
 
 def canonical(value):
@@ -225,6 +254,8 @@ class Campaign:
             canonical(opts)
         set_("estimator_options", {str(k): dict(v) for k, v in self.estimator_options.items()})
         object.__setattr__(self, "_cells", None)
+        object.__setattr__(self, "_sizes", ())
+        object.__setattr__(self, "_tried", ())
 
     # -- construction --------------------------------------------------------
 
@@ -283,8 +314,6 @@ class Campaign:
         for name in names:
             if not isinstance(name, str):
                 raise InputError(f"grid.estimator: estimator names are strings; got {name!r}")
-            if name not in registered_estimators():
-                load_providers()
             try:
                 entry = estimator_entry(name)
             except InputError:
@@ -305,35 +334,108 @@ class Campaign:
             raise InputError(f"tol must have 1 or {model.system.n} entries (one per state component); got "
                              f"{len(self.tol)}")
 
-    def cells(self):
-        """Every cell of the grid, in grid order (validated: unknown names and bad values are refused)."""
+    def _limits(self, limits):
+        merged = dict(LIMITS)
+        for key, value in (limits or {}).items():
+            if key not in LIMITS:
+                raise InputError(f"limits: unknown limit {key!r}; known: {', '.join(LIMITS)}")
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value > 0:
+                raise InputError(f"limits.{key} must be a number > 0; got {value!r}")
+            merged[key] = value
+        return merged
+
+    def _check_counts(self, limits):
+        """Runs and cells against ``limits``, from the grid's lengths alone (nothing is built)."""
+        if self.runs > limits["runs"]:
+            raise InputError(f"runs = {self.runs} exceeds the limit of {limits['runs']:g} runs per cell "
+                             "(raise it with limits={'runs': N} or --limit runs=N if you mean it)")
+        names = self.grid["estimator"]
+        n_est = len(registered_estimators()) if "all" in names else len(names)
+        n_cells = math.prod(len(v) for k, v in self.grid.items() if k != "estimator") * max(n_est, 1)
+        if n_cells > limits["cells"]:
+            sizes = " × ".join(f"{k} {len(v)}" for k, v in self.grid.items() if len(v) > 1 and k != "estimator")
+            raise InputError(f"grid: {n_cells} cells ({sizes or '1 point'} × {n_est} estimators) exceed the limit "
+                             f"of {limits['cells']:g} cells (raise it with limits={{'cells': N}} or --limit cells=N)")
+
+    def estimate(self):
+        """Estimated work and memory of the campaign (after validation): a dict.
+
+        ``steps``: estimator steps, cells × runs × the longest validated scenario's time steps; ``seconds``:
+        steps / :data:`STEPS_PER_SECOND` (one core); ``batch_bytes``: one batch of ``min(batch_size, runs)``
+        runs of the longest scenario, 8 bytes per number, for the true state, the estimate and the error
+        (n each), the measurements (p) and the input (m) at every step.
+        """
+        cells = self.cells()
+        steps, per_step = max(s[0] for s in self._sizes), max(s[1] for s in self._sizes)
+        total = float(len(cells)) * self.runs * steps
+        return {"steps": total, "seconds": total / STEPS_PER_SECOND,
+                "batch_bytes": float(min(self.batch_size, self.runs)) * (steps + 1) * per_step * 8}
+
+    def cells(self, limits=None):
+        """Every cell of the grid, in grid order, after the checks of the module docstring (limits, names, values).
+
+        Parameters
+        ----------
+        limits : dict, optional
+            Overrides of :data:`LIMITS` (name → maximum).
+        """
         if self._cells is not None:
             return self._cells
-        out = []
+        limits = self._limits(limits)
+        self._check_counts(limits)
+        sizes, tried, out = [], [], []
         for scenario_name in self.grid["scenario"]:
             scenario_entry(scenario_name, field="grid.scenario")
             skeys, ckeys = self._split(scenario_name)
-            for svals in itertools.product(*(self.grid[k] for k in skeys)):
-                settings = dict(zip(skeys, svals))
-                try:
-                    scenario = build_scenario(scenario_name, **settings)
-                except (InputError, TypeError, ValueError) as exc:
-                    raise InputError(f"grid ({', '.join(f'{k} = {v!r}' for k, v in settings.items())}): {exc}") from None
-                estimators = self._estimators(scenario, scenario_name)
-                for cvals in itertools.product(*(self.grid[k] for k in ckeys)):
-                    conditions = dict(zip(ckeys, cvals))
+            estimators = None
+            for settings in _variants(self.grid, skeys):
+                scenario = self._build(scenario_name, settings)
+                names = self._estimators(scenario, scenario_name)
+                estimators = names if estimators is None else estimators
+                tried.append((scenario_name, settings, scenario, tuple(names)))
+                first = len(tried) == 1 or tried[-2][0] != scenario_name
+                for conditions in _variants(self.grid, ckeys) if first else [{k: self.grid[k][0] for k in ckeys}]:
                     try:
                         model = scenario.truth_model(**conditions)
                     except (InputError, TypeError, ValueError) as exc:
                         where = ", ".join(f"{k} = {v!r}" for k, v in {**settings, **conditions}.items())
                         raise InputError(f"grid ({where}): {exc}") from None
                     self._check_windows(model, scenario_name)
+                    n, p = model.system.n, model.measurement.n_meas
+                    m = getattr(model.system, "n_input", n)
+                    sizes.append((int(model.n_steps), 3 * n + p + m))  # x, x̂, error, y, u per step and run
+            for svals in itertools.product(*(self.grid[k] for k in skeys)):
+                settings = dict(zip(skeys, svals))
+                for cvals in itertools.product(*(self.grid[k] for k in ckeys)):
+                    conditions = dict(zip(ckeys, cvals))
                     for noise in self.grid["noise"]:
                         out.extend(self._make_cells(scenario_name, settings, conditions, noise, estimators))
         if not out:
             raise InputError("grid: the grid has no cell")
+        object.__setattr__(self, "_sizes", tuple(sizes))
+        object.__setattr__(self, "_tried", tuple(tried))
         object.__setattr__(self, "_cells", tuple(out))
+        estimate = self.estimate()
+        for key, what in (("steps", "estimator steps"), ("batch_bytes", "bytes per batch")):
+            if estimate[key] > limits[key]:
+                object.__setattr__(self, "_cells", None)
+                hint = (f", about {estimate['seconds'] / 3600:.3g} core-hours" if key == "steps"
+                        else "; lower batch_size")
+                raise InputError(f"{'runs' if key == 'steps' else 'batch_size'}: the campaign's estimated "
+                                 f"{estimate[key]:.3g} {what}{hint} exceed the limit {key} = {limits[key]:.3g} "
+                                 f"(raise it with limits={{'{key}': N}} or --limit {key}=N if you mean it)")
         return self._cells
+
+    def tried(self):
+        """``(scenario name, settings, scenario, estimator names)`` of each settings combination validated."""
+        self.cells()
+        return self._tried
+
+    def _build(self, scenario_name, settings):
+        try:
+            return build_scenario(scenario_name, **settings)
+        except (InputError, TypeError, ValueError) as exc:
+            raise InputError(f"grid ({', '.join(f'{k} = {v!r}' for k, v in settings.items())}): {exc}") from None
 
     def _make_cells(self, scenario_name, settings, conditions, noise, estimators):
         truth = {"campaign_seed": self.seed, "scenario": scenario_name, "settings": settings,
@@ -351,6 +453,14 @@ class Campaign:
         return cells
 
 
+def _variants(grid, keys):
+    """Combinations of ``keys`` to validate: all of them up to :data:`FULL_CHECK`, else each value once."""
+    if math.prod(len(grid[k]) for k in keys) <= FULL_CHECK:
+        return [dict(zip(keys, vals)) for vals in itertools.product(*(grid[k] for k in keys))]
+    base = {k: grid[k][0] for k in keys}
+    return [base] + [{**base, k: v} for k in keys for v in grid[k][1:]]
+
+
 def load_campaign(spec):
     """A :class:`Campaign` from a Campaign, a dict, or the path of a TOML file."""
     if isinstance(spec, Campaign):
@@ -366,5 +476,8 @@ def load_campaign(spec):
                 data = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise InputError(f"spec: {path} is not valid TOML ({exc})") from None
+        except UnicodeDecodeError as exc:
+            raise InputError(f"spec: {path} is not UTF-8 text, as TOML requires (byte {exc.object[exc.start]:#04x} "
+                             f"at offset {exc.start}); save it as UTF-8 (it may be Latin-1 or Windows-1252)") from None
         return Campaign.from_dict(data, source=f"spec {path.name}")
     raise InputError(f"spec must be a Campaign, a dict or the path of a TOML file; got {type(spec).__name__}")

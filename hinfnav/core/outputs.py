@@ -2,8 +2,9 @@
 
 :func:`atomic_output_dir` checks the target before any work (an empty path, a
 file, a folder under a file, a folder that cannot be written, a folder holding
-files hinfnav did not write → a clear :class:`InputError`), takes a lock beside
-it (a second process writing into the same folder is refused), hands out a
+files hinfnav did not write → a clear :class:`InputError`), takes an OS-level lock
+beside it (:func:`output_lock`: a second process writing into the same folder
+is refused), hands out a
 temporary folder beside the target, and only when the work has finished
 replaces the target by it in two renames. An interrupted run leaves the
 previous complete folder untouched (and a ``.tmp`` folder that the next run
@@ -11,21 +12,24 @@ removes); no file ever mixes two runs.
 """
 
 import contextlib
-import errno
 import json
 import math
 import os
 import shutil
 from pathlib import Path
 
+import filelock
 import numpy as np
 
 from .exceptions import InputError
 
-__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "to_json", "write_json"]
+__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "write_json"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
 MARKER = ".hinfnav-output"
+#: Seconds a new run waits for the lock of an output folder before refusing (covers a holder that is just
+#: releasing it; a run in progress holds it for its whole length).
+_LOCK_WAIT_S = 0.5
 
 
 def check_output_dir(path, name="out"):
@@ -54,33 +58,36 @@ def check_output_dir(path, name="out"):
     return target
 
 
-def _lock(target):
-    lock = target.parent / f".{target.name}.lock"
-    lock.parent.mkdir(parents=True, exist_ok=True)
-    for _ in range(2):
-        try:
-            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
-        except FileExistsError:
-            try:
-                pid = int(lock.read_text().strip() or 0)
-            except (OSError, ValueError):
-                pid = 0
-            alive = pid > 0
-            if alive:
-                try:
-                    os.kill(pid, 0)
-                except OSError as exc:
-                    alive = exc.errno == errno.EPERM
-            if alive:
-                raise InputError(
-                    f"another process (pid {pid}) is writing into {target}; wait for it or choose another folder"
-                ) from None
-            lock.unlink(missing_ok=True)  # stale lock of a process that died
-            continue
-        with os.fdopen(fd, "w") as fh:
-            fh.write(str(os.getpid()))
-        return lock
-    raise InputError(f"could not lock {target} (lock file {lock})")
+def lock_path(target):
+    """The lock file of the output folder ``target``: ``.<name>.lock`` beside it."""
+    target = Path(target)
+    return target.parent / f".{target.name}.lock"
+
+
+@contextlib.contextmanager
+def output_lock(target, name="out"):
+    """Context manager: hold the OS-level lock of the output folder ``target`` (another holder → InputError).
+
+    The lock is an advisory ``flock``/``LockFileEx`` lock taken through :mod:`filelock` on
+    ``.<name>.lock`` beside the folder: the operating system releases it when the holder exits, however it
+    exits (even SIGKILL), so a stale lock cannot exist and no process ever deletes another's lock. The file
+    is removed while the lock is still held (a process that opened it meanwhile sees an unlinked file and
+    tries again, which ``filelock`` does), so a finished run leaves nothing beside its folder.
+    """
+    lock_file = lock_path(target)
+    lock_file.parent.mkdir(parents=True, exist_ok=True)
+    lock = filelock.FileLock(lock_file, timeout=_LOCK_WAIT_S, is_singleton=False)
+    try:
+        lock.acquire()
+    except filelock.Timeout:
+        raise InputError(f"{name}: another process is writing into {target} (it holds the lock {lock_file}); "
+                         "wait for it to finish or choose another folder") from None
+    try:
+        yield lock_file
+    finally:
+        with contextlib.suppress(OSError):
+            lock_file.unlink()
+        lock.release()
 
 
 @contextlib.contextmanager
@@ -98,26 +105,25 @@ def atomic_output_dir(path, *, keep=(), name="out"):
         Parameter name used in error messages.
     """
     target = check_output_dir(path, name)
-    lock = _lock(target)
-    tmp = target.parent / f".{target.name}.tmp"
-    try:
-        shutil.rmtree(tmp, ignore_errors=True)
-        tmp.mkdir(parents=True)
-        (tmp / MARKER).write_text("written by hinfnav; this folder is replaced whole by the next run\n")
-        yield tmp
-        for entry in keep:
-            src = target / entry
-            if src.exists() and not (tmp / entry).exists():
-                shutil.copytree(src, tmp / entry) if src.is_dir() else shutil.copy2(src, tmp / entry)
-        old = target.parent / f".{target.name}.old"
-        shutil.rmtree(old, ignore_errors=True)
-        if target.exists():
-            target.rename(old)
-        tmp.rename(target)
-        shutil.rmtree(old, ignore_errors=True)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-        lock.unlink(missing_ok=True)
+    with output_lock(target, name):
+        tmp = target.parent / f".{target.name}.tmp"
+        try:
+            shutil.rmtree(tmp, ignore_errors=True)
+            tmp.mkdir(parents=True)
+            (tmp / MARKER).write_text("written by hinfnav; this folder is replaced whole by the next run\n")
+            yield tmp
+            for entry in keep:
+                src = target / entry
+                if src.exists() and not (tmp / entry).exists():
+                    shutil.copytree(src, tmp / entry) if src.is_dir() else shutil.copy2(src, tmp / entry)
+            old = target.parent / f".{target.name}.old"
+            shutil.rmtree(old, ignore_errors=True)
+            if target.exists():
+                target.rename(old)
+            tmp.rename(target)
+            shutil.rmtree(old, ignore_errors=True)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
 
 
 def to_json(obj, *, strict=False):

@@ -5,13 +5,21 @@ A builder takes a scenario (and options) and returns an
 the estimator applies to that scenario. The simulation resolves estimator
 names through :func:`build_estimator`; the contract test suite runs over
 :func:`registered_estimators`.
+
+The modules that register estimators (the papers, which sit above this layer)
+are found through the entry-point group :data:`PROVIDER_GROUP`, as a plugin
+host finds its plugins: :func:`registered_estimators` loads them on its first
+call, and :func:`estimator_entry` on an unknown name, so a fresh Python process
+lists and builds every paper's estimators without this layer naming a paper.
 """
 
 from dataclasses import dataclass
+from importlib import metadata
 
 from ..core.exceptions import InputError
 
-__all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry"]
+__all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
+           "providers", "PROVIDER_GROUP"]
 
 
 @dataclass(frozen=True)
@@ -23,6 +31,35 @@ class _Entry:
 
 
 _REGISTRY = {}
+
+#: Entry-point group of the modules that register scenarios and estimators when imported. This
+#: package declares its papers (``hinfnav.papers``) in ``pyproject.toml``; another installed package
+#: may declare its own.
+PROVIDER_GROUP = "hinfnav.providers"
+
+_PROVIDERS = {"loaded": False}
+
+
+def providers():
+    """The provider modules declared under :data:`PROVIDER_GROUP` by the installed packages."""
+    return tuple(ep.value for ep in metadata.entry_points(group=PROVIDER_GROUP))
+
+
+def load_providers():
+    """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
+    _PROVIDERS["loaded"] = True  # first, so that a provider asking for the registry while it loads does not recurse
+    failed = {}
+    for ep in metadata.entry_points(group=PROVIDER_GROUP):
+        try:
+            ep.load()
+        except ImportError as exc:  # pragma: no cover - a provider under construction
+            failed[ep.value] = str(exc)
+    return failed
+
+
+def _ensure_providers():
+    if not _PROVIDERS["loaded"]:
+        load_providers()
 
 
 def register_estimator(name, builder, *, fits=None, description=""):
@@ -46,12 +83,18 @@ def register_estimator(name, builder, *, fits=None, description=""):
 
 
 def registered_estimators(scenario=None):
-    """Names of the registered estimators (that fit ``scenario`` when given), in registration order."""
+    """Names of the registered estimators (that fit ``scenario`` when given), in registration order.
+
+    The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
+    """
+    _ensure_providers()
     return tuple(n for n, e in _REGISTRY.items() if scenario is None or e.fits(scenario))
 
 
 def estimator_entry(name):
-    """The registry entry of ``name`` (builder, fits, description)."""
+    """The registry entry of ``name`` (builder, fits, description); an unknown name loads the providers first."""
+    if isinstance(name, str) and name not in _REGISTRY:
+        _ensure_providers()
     if not isinstance(name, str) or name not in _REGISTRY:
         raise InputError(f"unknown filter {name!r}; choose one of: {', '.join(_REGISTRY)}")
     return _REGISTRY[name]

@@ -126,13 +126,18 @@ class Solution:
     seconds: float = 0.0
 
 
+#: Seconds one SCS solve may take (SCS's ``time_limit_secs``): SCS on LMI (20) otherwise runs for minutes
+#: (issue 22: ``design --solver SCS`` past 60 s); what it returns is certified independently all the same.
+SCS_TIME_LIMIT_S = 20.0
+
+
 def solver_kwargs(solver, accuracy):
     if solver == "CLARABEL":
         return {"tol_gap_abs": accuracy, "tol_gap_rel": accuracy, "tol_feas": accuracy, "max_iter": 400}
     if solver == "CVXOPT":
         return {"abstol": accuracy, "reltol": accuracy, "feastol": accuracy, "max_iters": 400}
     if solver == "SCS":
-        return {"eps_abs": accuracy * 10, "eps_rel": accuracy * 10, "max_iters": 200000}
+        return {"eps_abs": accuracy * 10, "eps_rel": accuracy * 10, "max_iters": 200000, "time_limit_secs": SCS_TIME_LIMIT_S}
     return {}
 
 
