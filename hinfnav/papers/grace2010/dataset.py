@@ -67,13 +67,12 @@ def _seconds(dates, times):
 
 
 def _rows(source, n_numbers):
-    if hasattr(source, "read_text") or isinstance(source, str):
-        opener = gzip.open if str(source).endswith(".gz") else open
-        with (source.open("rb") if hasattr(source, "open") and not isinstance(source, str) else open(source, "rb")) as raw:
-            text = (gzip.decompress(raw.read()) if str(source).endswith(".gz") else raw.read()).decode("ascii")
-        del opener
-    else:
-        raise InputError(f"source must be a path; got {type(source).__name__}")
+    """Date and time strings and the numbers of a CSV file (gzip when its name ends in .gz)."""
+    try:
+        raw = source.read_bytes() if hasattr(source, "read_bytes") else open(source, "rb").read()
+    except (OSError, TypeError) as exc:
+        raise InputError(f"source must be a readable file; {source!r}: {exc}") from None
+    text = (gzip.decompress(raw) if str(source).endswith(".gz") else raw).decode("ascii")
     dates, times, nums = [], [], []
     for i, line in enumerate(text.splitlines()):
         if not line.strip():
