@@ -131,3 +131,19 @@ def test_vendored_files_equal_the_published_ones(data):
     assert np.array_equal(read_range_file(shared / "grc_kb_rng.csv")[1], data.kband)
     with pytest.raises(InputError, match="source"):
         read_range_file(shared / "missing.csv")
+
+
+def test_truth_first_epoch_by_hand(data):
+    # independent computation at 00:00:00 (θ = 0): r_I = r_E, v_I = v_E + ω_E × r_E, Hill axes by hand
+    w = np.array([0.0, 0.0, 7.292115e-5])
+    rA, rB = data.rA_ecef[0], data.rB_ecef[0]
+    vA, vB = data.vA_ecef[0] + np.cross(w, rA), data.vB_ecef[0] + np.cross(w, rB)
+    h = np.cross(rB, vB)
+    ex, ez = rB / np.linalg.norm(rB), h / np.linalg.norm(h)
+    M = np.array([ex, np.cross(ez, ex), ez])
+    rho = M @ (rA - rB)
+    rate = np.linalg.norm(h) / (rB @ rB)
+    drho = M @ (vA - vB) - np.cross([0.0, 0.0, rate], rho)
+    assert np.allclose(data.truth[0], np.r_[rho, drho], rtol=0, atol=1e-6)
+    # SOURCE.md: GRACE-A ≈ 227 km behind (y < 0), a few km below (x < 0)
+    assert -2.28e5 < rho[1] < -2.26e5 and -4.8e3 < rho[0] < -2.8e3
