@@ -65,7 +65,10 @@ def pair(absolute):
 
     def f(x, u=None, t=0.0):
         x = np.asarray(x, float)
-        return np.concatenate([absolute(x[..., :6], None, t), absolute(x[..., 6:], u, t)], axis=-1)
+        out = absolute(x.reshape(x.shape[:-1] + (2, 6)), None, t)  # both spacecraft in one call
+        if u is not None:
+            out[..., 1, 3:] += u
+        return out.reshape(x.shape)
 
     return f
 
