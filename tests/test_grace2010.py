@@ -9,7 +9,6 @@ from hinfnav.papers.grace2010 import (
     hill_to_inertial,
     hill_transition,
     inertial_to_ecef,
-    inertial_to_hill,
     kband_check,
     load,
     make_measurements,
@@ -72,7 +71,7 @@ def test_rk4_two_body_keeps_energy_and_j2_changes_it():
     # closed form: two-body specific energy v²/2 − μ/r is conserved; RK4 at 10 s keeps it to 1e-6 relative
     x0 = np.array([6.85e6, 0, 0, 0, 5.4e3, 5.4e3])
     x1 = rk4(two_body, x0, 0.0, 10.0, 560)
-    energy = lambda x: 0.5 * x[3:] @ x[3:] - 3.986004418e14 / np.linalg.norm(x[:3])  # noqa: E731
+    energy = lambda x: 0.5 * x[3:] @ x[3:] - 3.986004418e14 / np.linalg.norm(x[:3])
     assert abs(energy(x1) / energy(x0) - 1) < 1e-6
     assert np.linalg.norm(rk4(two_body_j2, x0, 0.0, 10.0, 560)[:3] - x1[:3]) > 1e3  # J2 moves it km in an orbit
     with pytest.raises(InputError, match="dt"):
@@ -106,7 +105,7 @@ def test_ekf_on_real_day_beats_measurement_noise(data):
     # per-axis noise (the averaging a correct model allows); checked over the first 2000 epochs
     n = 2000
     ms = make_measurements(data, "gnss", seed=0)
-    y_lin, lin = linear_form(ms)
+    _, lin = linear_form(ms)
     one = one_step_mismatch(data)
     Qj2 = model_mismatch_moment(data, "two_body_j2")
     built = build_filters(data, ms.model, lin, one["Q_mismatch"], Qj2)

@@ -69,7 +69,11 @@ def _seconds(dates, times):
 def _rows(source, n_numbers):
     """Date and time strings and the numbers of a CSV file (gzip when its name ends in .gz)."""
     try:
-        raw = source.read_bytes() if hasattr(source, "read_bytes") else open(source, "rb").read()
+        if hasattr(source, "read_bytes"):
+            raw = source.read_bytes()
+        else:
+            with open(source, "rb") as fh:
+                raw = fh.read()
     except (OSError, TypeError) as exc:
         raise InputError(f"source must be a readable file; {source!r}: {exc}") from None
     text = (gzip.decompress(raw) if str(source).endswith(".gz") else raw).decode("ascii")

@@ -32,12 +32,22 @@ import numpy as np
 from ...analysis.observer import observer_form
 from ...core.exceptions import HinfnavError, LooseBoundWarning, SolverAccuracyWarning
 from ...design import SampleSet, SolverOptions, synthesize, synthesize_mixed
-from ...estimators import ExtendedKalmanFilter, FilterState, HuberFilter, RecursiveHInfinityFilter
+from ...estimators import (
+    ExtendedKalmanFilter,
+    FilterState,
+    HuberFilter,
+    RecursiveHInfinityFilter,
+)
 from ...estimators.augmented import AugmentedInputAdaptiveKF, AugmentedInputSTKF
 from ...estimators.lti import LTIFilter
-from ...systems.hill import hill_system, measurement_matrix, uncertainty_F, uncertainty_structure
+from ...systems.hill import (
+    hill_system,
+    measurement_matrix,
+    uncertainty_F,
+    uncertainty_structure,
+)
 from .constants import DT_S
-from .dataset import inertial_to_hill, hill_to_inertial
+from .dataset import hill_to_inertial, inertial_to_hill
 from .dynamics import MODELS, pair, rk4
 from .mismatch import SUBSTEPS, hill_transition
 

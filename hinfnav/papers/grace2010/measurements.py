@@ -39,7 +39,13 @@ from ...systems.measurements import (
     position_from_range_angles,
     range_angles,
 )
-from .constants import ANGLE_SIGMA_RAD, DROPOUT_FRACTION, GNSS_SIGMA_M, OUTLIER_FRACTION, OUTLIER_SCALE
+from .constants import (
+    ANGLE_SIGMA_RAD,
+    DROPOUT_FRACTION,
+    GNSS_SIGMA_M,
+    OUTLIER_FRACTION,
+    OUTLIER_SCALE,
+)
 
 __all__ = ["VARIANTS", "DROPOUT_BLOCK", "MeasurementSet", "kband_noise", "make_measurements", "linear_form"]
 

@@ -20,7 +20,14 @@ from ..notebooks import run_notebooks
 from .constants import CITATION, DT_S, KBAND_TOLERANCE_M, TRUTH_SIGMA_M
 from .dataset import load
 from .figures import errors_figure, mismatch_figure, truth_figure
-from .filters import DESIGN_DAMPING, FILTER_NAMES, P0_STD, build_filters, lmi_designs, model_mismatch_moment
+from .filters import (
+    DESIGN_DAMPING,
+    FILTER_NAMES,
+    P0_STD,
+    build_filters,
+    lmi_designs,
+    model_mismatch_moment,
+)
 from .measurements import VARIANTS, kband_noise, linear_form, make_measurements
 from .mismatch import chief_rate_range, one_step_mismatch, propagation_errors
 from .studies import SETTLE_S, error_metrics, run_filter

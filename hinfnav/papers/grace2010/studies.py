@@ -17,7 +17,6 @@ from ...core.exceptions import InputError
 from ...estimators import ExtendedKalmanFilter
 from ...estimators.augmented import AugmentedEKF
 from ...estimators.lti import LTIFilter
-from .constants import DT_S
 
 __all__ = ["SETTLE_S", "run_filter", "nees", "error_metrics"]
 
