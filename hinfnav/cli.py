@@ -30,7 +30,7 @@ SOLVER_CHOICES = ("CLARABEL", "CVXOPT", "SCS")
 #: Largest ``--runs`` (= hinfnav.papers.sun2011.report.MAX_RUNS), checked before anything heavy is imported.
 MAX_RUNS = 1_000_000
 #: ``reproduce --paper`` choices (= the selections and keys of hinfnav.papers: tested).
-PAPER_CHOICES = ("papers", "all", "sun2011", "shi2018", "attitude2018", "yang2020", "benchmark")
+PAPER_CHOICES = ("papers", "all", "sun2011", "shi2018", "attitude2018", "yang2020", "grace2010", "benchmark")
 
 
 def simulate_report(*args, **kwargs):

@@ -16,6 +16,8 @@ attitude2018  star-sensor (gyroless) attitude estimation with augmented, adaptiv
 yang2020      Yang, Tan, Xue, Guo, Zhao, extended-state filtering with saturated
               observations and ADRC for drag-free satellites, Acta Automatica
               Sinica 46(11), 2020
+grace2010     not a paper: every filter on the real GRACE-A/B formation of 27 July
+              2010 against its precise-orbit truth (issue 20; LEOGPS data, MIT)
 benchmark     every registered estimator on every scenario where it fits, run as
               a Dask campaign (not a paper: part of ``--paper all`` only)
 =========  ====================================================================
@@ -27,9 +29,9 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from ..core.validation import check_keywords
 from ..core.outputs import MARKER, atomic_output_dir
-from . import attitude2018, benchmark, shi2018, sun2011, yang2020
+from . import attitude2018, benchmark, grace2010, shi2018, sun2011, yang2020
 
-__all__ = ["PAPERS", "SELECTIONS", "reproduce", "sun2011", "shi2018", "attitude2018", "yang2020", "benchmark"]
+__all__ = ["PAPERS", "SELECTIONS", "reproduce", "sun2011", "shi2018", "attitude2018", "yang2020", "grace2010", "benchmark"]
 
 #: Reproducible papers: key -> its ``reproduce(out_dir, seed=, runs=, notebooks=, progress=)``.
 #: The primary paper (sun2011) writes into the output folder itself, as it always has;
@@ -39,12 +41,13 @@ PAPERS = {
     "shi2018": shi2018.reproduce,
     "attitude2018": attitude2018.reproduce,
     "yang2020": yang2020.reproduce,
+    "grace2010": grace2010.reproduce,
     "benchmark": benchmark.reproduce,
 }
 
-#: Named selections: ``papers`` (the default of ``reproduce``) is the four papers; ``all`` adds the
-#: cross-paper benchmark campaign.
-SELECTIONS = {"papers": ("sun2011", "shi2018", "attitude2018", "yang2020"), "all": tuple(PAPERS)}
+#: Named selections: ``papers`` (the default of ``reproduce``) is the four papers and the GRACE real-data
+#: study; ``all`` adds the cross-paper benchmark campaign.
+SELECTIONS = {"papers": ("sun2011", "shi2018", "attitude2018", "yang2020", "grace2010"), "all": tuple(PAPERS)}
 
 
 #: The paper that writes into the output folder itself (the others into sub-folders).
@@ -52,7 +55,7 @@ PRIMARY = "sun2011"
 
 
 def reproduce(paper="papers", out_dir="results", **options):
-    """Reproduce one paper, the four papers (``"papers"``), or those and the benchmark (``"all"``), atomically.
+    """Reproduce one paper, the four papers and the GRACE study (``"papers"``), or those and the benchmark (``"all"``), atomically.
 
     ``runs=None`` (or leaving it out) uses each paper's own default (a single
     closed-loop run for yang2020, 100 Monte Carlo runs for sun2011, …).
