@@ -62,7 +62,7 @@ from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_matrix, as_positive
 from ..noise import GaussianNoise, LaplaceNoise, MixtureNoise, NoiseModel, StudentTNoise
 
-__all__ = ["posterior_crb", "rms_bound", "noise_fisher_information", "measurement_information"]
+__all__ = ["measurement_information", "noise_fisher_information", "posterior_crb", "rms_bound"]
 
 
 def _jacobian_source(name, value, rows, n):
@@ -75,7 +75,7 @@ def _jacobian_source(name, value, rows, n):
                 out = np.asarray(value(x), dtype=float)
             except InputError:
                 raise
-            except Exception as exc:  # a user callable; report it under the parameter name
+            except (TypeError, ValueError, IndexError, ArithmeticError) as exc:  # a user callable: name the parameter
                 raise InputError(f"{name} failed on a batch of states of shape {x.shape}: {exc}") from None
             want = (x.shape[0], rows, n) if rows is not None else None
             if out.ndim != 3 or out.shape[0] != x.shape[0] or out.shape[2] != n or (want and out.shape != want):
