@@ -4,8 +4,10 @@ For ``x(k+1) = f(x(k)) + w(k)``, ``y(k) = h(x(k)) + v(k)`` with white additive
 noise, ``w ~ N(0, Q)``, ``v`` of covariance ``R`` and ``x(0) ~ p₀`` of
 covariance ``P₀``, every estimator x̂(k) of x(k) from y(0) … y(k) satisfies
 ``E[(x̂ − x)(x̂ − x)ᵀ] ⪰ J(k)⁻¹`` (the posterior, or Bayesian, CRB). The
-information obeys Tichavský et al. (1998), eqs. (21)–(22) specialised to
-additive Gaussian process noise (their Section IV)::
+information obeys the recursion of Tichavský et al. (1998), specialised to
+additive Gaussian process noise (labels (T1)–(T2) are this module's; the
+paper itself is not in the workbook's library, so its equation numbers are
+not quoted)::
 
     J(k+1) = D22 − D21 (J(k) + D11)⁻¹ D12,                          (T1)
     D11 = E[Fᵀ Q⁻¹ F],  D12 = D21ᵀ = −E[Fᵀ] Q⁻¹,
@@ -31,12 +33,17 @@ Kalman covariance recursion). ``Q⁻¹`` is left only in the spread term of
 (P1), which vanishes for linear f. There, a singular Q is replaced by
 ``Q_ε = U max(λ, ε λ_max) Uᵀ`` (eigen-decomposition ``Q = U λ Uᵀ``, relative
 floor ε, default 1e-9): the bound of the regularised problem, whose ε → 0
-limit is a bound for the singular one. The spread term is finite as ε → 0
-when the Jacobian varies only in the rows of the noisy states (e.g. a
-pendulum with noise on the rate); then ε has no measurable effect (tested:
-relative change below 1e-6 between ε = 1e-9 and 1e-6). When the Jacobian of
-a noise-free state varies over the runs, the limit treats that variation as
-perfectly informative and the bound is loose in those directions.
+limit is a bound for the singular one (if the optimal MSE is continuous in
+ε). The spread term does not depend on ε when the Jacobian varies only in
+the rows of the noisy states (a pendulum with noise on the rate: identical
+bounds for ε = 1e-9 and 1e-6, and the literal (T1) with ``Q + δI`` converges
+to it linearly, 3.9e-5 relative at δ = 1e-8; tests/test_pcrb.py). When the
+Jacobian of a noise-free state varies over the runs (the pendulum with noise
+on the angle only), ε does enter; the bound converges as ε → 0 (measured:
+1.6e-4 relative change from ε = 1e-6 to 1e-9, 1.3e-6 from 1e-9 to 1e-12,
+the rounding of an information of size 1/ε)
+but that limit treats the run-to-run spread of the Jacobian as perfectly
+informative, so it may be optimistic (a loose lower bound) there.
 
 Everything is propagated in covariance form, ``P = J⁻¹``; adding an
 information ``M = LᵀL`` is the Joseph-form update with the equivalent
@@ -47,10 +54,16 @@ Non-Gaussian measurement noise
 The bound computed with Gaussian noise of the same covariance is NOT a bound
 for other noise densities: by the scalar Cramér–Rao inequality a
 unit-variance density has location Fisher information ``j ≥ 1``, with
-equality only for the Gaussian, so a heavy-tailed sensor carries more
-information about x than a Gaussian one of the same variance. For
+equality only for the Gaussian, so any other sensor density (the mixture and
+Student-t of :mod:`hinfnav.noise` included) carries more information about x
+than a Gaussian one of the same variance. For
 ``v = D e`` with square invertible D and i.i.d. unit-variance channels of
 information j, ``Λ = D⁻ᵀ (j I) D⁻¹ = j R⁻¹`` (:func:`measurement_information`).
+The same holds for the other two inputs, not handled here: a non-Gaussian
+process noise replaces ``Q⁻¹`` by its Fisher information, and a non-Gaussian
+prior has ``J(0) ⪰ P₀⁻¹`` (so P0 must then be the inverse of the prior's
+Fisher information, not its covariance). Non-additive noise needs the
+general expectations of the paper, not this additive form.
 """
 
 import numpy as np
@@ -178,12 +191,22 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
         Lam = 0.5 * (Lam + Lam.T)
     lam_q, U = np.linalg.eigh(Q)
     lam_max = max(float(lam_q[-1]), 0.0)
-    Q_inv_reg = None
+    root_q_inv = None
     if lam_max > 0:
-        Q_inv_reg = (U / np.maximum(lam_q, eps * lam_max)) @ U.T
+        root_q_inv = (U / np.sqrt(np.maximum(lam_q, eps * lam_max))).T      # Q_ε^{-1/2}-like root of Q_ε⁻¹
+
+    def root(M):                       # Mʰ with Mʰᵀ Mʰ = M for a PSD M (so that E[Gᵀ M G] is one product)
+        mu, V = np.linalg.eigh(M)
+        return np.sqrt(np.maximum(mu, 0.0))[:, None] * V.T
+
+    def mean_quadratic(G, root_M):     # E[Gᵀ M G] over the runs, as (Mʰ G)ᵀ (Mʰ G) stacked
+        A = (root_M @ G).reshape(-1, n)
+        return A.T @ A / G.shape[0]
+
+    root_lam = root(Lam)
 
     def info(H):
-        return np.einsum("rji,jk,rkl->il", H, Lam, H) / H.shape[0]
+        return mean_quadratic(H, root_lam)
 
     out = np.empty((n_steps, n) if diagonal_only else (n_steps, n, n))
     if initial_update:
@@ -196,10 +219,10 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
         scale = max(float(np.max(np.abs(F_bar))), 1.0)
         S_inv = P
         if np.max(np.abs(dF)) > 1e-13 * scale:
-            if Q_inv_reg is None:
+            if root_q_inv is None:
                 raise InputError("Q is zero but dynamics_jacobian varies over the runs; the bound (P1) needs a "
                                  "process-noise covariance (give a small positive Q)")
-            S_inv = _add_information(P, np.einsum("rji,jk,rkl->il", dF, Q_inv_reg, dF) / runs)   # (P1)
+            S_inv = _add_information(P, mean_quadratic(dF, root_q_inv))                           # (P1)
         P_pred = F_bar @ S_inv @ F_bar.T + Q                                                        # (P2)
         P = _add_information(0.5 * (P_pred + P_pred.T), info(H_of(X[:, k + 1, :])))
         out[k + 1] = np.diag(P) if diagonal_only else P
