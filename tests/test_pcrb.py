@@ -253,6 +253,9 @@ def test_fisher_information_of_noise_models():
         ({"measurement_jacobian": np.ones((1, 3))}, "measurement_jacobian"),
         ({"measurement_information": np.eye(2)}, "measurement_information"),
         ({"epsilon": -1.0}, "epsilon"),
+        ({"truth_states": [["a"]]}, "truth_states"),
+        ({"diagonal_only": "yes"}, "diagonal_only"),
+        ({"dynamics_jacobian": lambda x: x[:, :, :, None]}, "dynamics_jacobian"),
     ],
 )
 def test_bad_inputs_name_the_parameter(kwargs, name):

@@ -166,12 +166,18 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
     InputError
         Bad shapes or values, naming the parameter.
     """
-    X = np.asarray(truth_states, dtype=float) if not isinstance(truth_states, np.ndarray) else truth_states
+    try:
+        X = np.asarray(truth_states, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"truth_states must be a numeric array (runs, n_steps, n); got {type(truth_states).__name__}") from None
+    for flag, value in (("initial_update", initial_update), ("diagonal_only", diagonal_only)):
+        if not isinstance(value, (bool, np.bool_)):
+            raise InputError(f"{flag} must be True or False; got {value!r}")
     if X.ndim != 3 or min(X.shape) < 1:
         raise InputError(f"truth_states must have shape (runs, n_steps, n) with every size >= 1; got {np.shape(X)}")
     if not np.all(np.isfinite(X)):
         raise InputError("truth_states must contain only finite numbers; it has NaN or inf entries")
-    runs, n_steps, n = X.shape
+    _, n_steps, n = X.shape
     Q = as_covariance("Q", Q, n, definite=False)
     P = as_covariance("P0", P0, n, definite=False)
     eps = as_positive("epsilon", epsilon)
@@ -193,7 +199,7 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
     lam_max = max(float(lam_q[-1]), 0.0)
     root_q_inv = None
     if lam_max > 0:
-        root_q_inv = (U / np.sqrt(np.maximum(lam_q, eps * lam_max))).T      # Q_ε^{-1/2}-like root of Q_ε⁻¹
+        root_q_inv = (U / np.sqrt(np.maximum(lam_q, eps * lam_max))).T      # rootᵀ root = Q_ε⁻¹
 
     def root(M):                       # Mʰ with Mʰᵀ Mʰ = M for a PSD M (so that E[Gᵀ M G] is one product)
         mu, V = np.linalg.eigh(M)
