@@ -25,6 +25,21 @@ from hinfnav.systems.measurements import RangeAzimuthElevation
 P0_CHASER = np.diag([100.0, 100.0, 100.0, 1e-2, 1e-2, 1e-2])  # 10 m, 0.1 m/s prior standard deviations
 
 
+def test_non_gaussian_measurement_information_tightens_the_bound():
+    # Λ = j R⁻¹ on a linear model is the Kalman recursion with R/j (closed form); j = 1.25 for Student-t(5)
+    sc = Scenario()
+    sysm, meas = sc.system(), sc.measurement
+    Lam = measurement_information(meas.D, StudentTNoise(5))
+    X = np.zeros((1, 100, 6))
+    bound = posterior_crb(X, sysm.Phi, meas, sysm.Q, None, P0_CHASER, measurement_information=Lam)
+    P_kf = _kalman_covariances(sysm.Phi, meas.C, sysm.Q, meas.R / 1.25, P0_CHASER, 100)
+    assert np.max(np.abs(bound - P_kf)) / np.max(np.abs(P_kf)) < 1e-10
+    gaussian = posterior_crb(X, sysm.Phi, meas, sysm.Q, meas.R, P0_CHASER)
+    nb, ng = np.diagonal(bound, axis1=1, axis2=2), np.diagonal(gaussian, axis1=1, axis2=2)
+    assert np.all(nb <= ng * (1 + 1e-12))             # more information, never a larger bound
+    assert np.all(nb[:, :3] < ng[:, :3])              # strictly smaller on the measured positions
+
+
 def _kalman_covariances(Phi, C, Q, R, P0, n_steps):
     """Closed-form Kalman covariance recursion P(k|k), first update at k = 0 (independent of the module)."""
     out, P = [], P0
@@ -259,8 +274,8 @@ def test_fisher_information_of_noise_models():
     ],
 )
 def test_bad_inputs_name_the_parameter(kwargs, name):
-    args = {"truth_states": np.zeros((2, 3, 2)), "dynamics_jacobian": np.eye(2), "measurement_jacobian": np.ones((1, 2)),
-            "Q": np.eye(2), "R": np.eye(1), "P0": np.eye(2)}
+    args = {"truth_states": np.zeros((2, 3, 2)), "dynamics_jacobian": np.eye(2),
+            "measurement_jacobian": np.ones((1, 2)), "Q": np.eye(2), "R": np.eye(1), "P0": np.eye(2)}
     args.update(kwargs)
     with pytest.raises(InputError, match=name):
         posterior_crb(**args)

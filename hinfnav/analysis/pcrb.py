@@ -169,7 +169,8 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
     try:
         X = np.asarray(truth_states, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"truth_states must be a numeric array (runs, n_steps, n); got {type(truth_states).__name__}") from None
+        raise InputError("truth_states must be a numeric array (runs, n_steps, n); "
+                         f"got {type(truth_states).__name__}") from None
     for flag, value in (("initial_update", initial_update), ("diagonal_only", diagonal_only)):
         if not isinstance(value, (bool, np.bool_)):
             raise InputError(f"{flag} must be True or False; got {value!r}")
