@@ -17,6 +17,7 @@ from .norms import (
 )
 from .hinf_riccati import max_admissible_theta, steady_state_hinf
 from .observer import observer_form
+from .pcrb import measurement_information, noise_fisher_information, posterior_crb, rms_bound
 from .riccati import stationary_lti_error_covariance, steady_state_kalman
 from .truncated import truncated_normal_moments
 
@@ -44,4 +45,8 @@ __all__ = [
     "steady_state_hinf",
     "max_admissible_theta",
     "truncated_normal_moments",
+    "posterior_crb",
+    "rms_bound",
+    "noise_fisher_information",
+    "measurement_information",
 ]
