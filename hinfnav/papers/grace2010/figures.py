@@ -1,6 +1,7 @@
 """Figures of the GRACE study: the truth, the mismatch growth, and the filters' errors against time."""
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 
 from ...plotting.errors import new_figure
 from .constants import TRUTH_SIGMA_M
@@ -57,8 +58,6 @@ def mismatch_figure(prop):
 def errors_figure(t, errors, variant, names=None, window=60):
     """RMS position error per Hill axis over sliding ``window``-epoch windows (10 min), log scale, against
     time, with the truth's own ≈ 2.8 cm (1σ, relative) marked. ``errors``: filter name → (n, 6) error (m, m/s)."""
-    from scipy.ndimage import uniform_filter1d
-
     names = list(errors) if names is None else names
     fig, ax = new_figure(3, 1, figsize=(10, 8), sharex=True)
     t_h = np.asarray(t) / 3600.0

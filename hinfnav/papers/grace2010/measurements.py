@@ -28,6 +28,7 @@ conversion at the day's mean reading (:func:`linear_form`).
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import savgol_coeffs, savgol_filter
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_seed
@@ -89,8 +90,6 @@ def kband_noise(data, window=11, order=3):
     -------
     dict (m)
     """
-    from scipy.signal import savgol_coeffs, savgol_filter
-
     k = data.kband
     res = k - savgol_filter(k, window, order)
     h0 = savgol_coeffs(window, order)[window // 2]
