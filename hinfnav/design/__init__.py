@@ -7,6 +7,8 @@ the solver reported.
 from ..lmi.solve import SOLVERS, SolverOptions
 from .io import check_design_system, load_design, save_design, system_fingerprint
 from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
+from .explain import small_gain_number
+from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
 from .result import SynthesisResult
 from .robust_hinf import FORMS, synthesize
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
@@ -31,4 +33,8 @@ __all__ = [
     "load_design",
     "check_design_system",
     "system_fingerprint",
+    "synthesize_polytopic",
+    "certify_polytopic",
+    "PolytopicResult",
+    "small_gain_number",
 ]

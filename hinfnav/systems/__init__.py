@@ -26,6 +26,7 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 
@@ -50,4 +51,7 @@ __all__ = [
     "measurement_matrix",
     "position_measurement",
     "UncertainSystem",
+    "PolytopicSystem",
+    "simplex_grid",
+    "two_mass_spring",
 ]
