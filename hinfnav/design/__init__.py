@@ -5,10 +5,12 @@ the solver reported.
 """
 
 from ..lmi.solve import SOLVERS, SolverOptions
+from .from_file import design_from_system_file, design_summary
 from .io import check_design_system, load_design, save_design, system_fingerprint
 from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
 from .explain import small_gain_number
 from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
+from .recertify import recertify
 from .result import SynthesisResult
 from .robust_hinf import FORMS, synthesize
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
@@ -37,4 +39,7 @@ __all__ = [
     "certify_polytopic",
     "PolytopicResult",
     "small_gain_number",
+    "recertify",
+    "design_from_system_file",
+    "design_summary",
 ]

@@ -37,6 +37,7 @@ from ..core.validation import as_choice, as_int_at_least
 from ..lmi.polytopic import extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
+from ..systems.uncertain import UncertainSystem
 from .explain import unstable_plant_message
 from .result import SynthesisResult
 
@@ -83,6 +84,8 @@ class PolytopicResult:
     solve_time_s, total_time_s : float
     dt : float
     attempts : tuple of str
+    system : PolytopicSystem or None
+        The polytope the filter was designed for.
     """
 
     A_F: np.ndarray
@@ -104,6 +107,7 @@ class PolytopicResult:
     total_time_s: float = 0.0
     dt: float = 1.0
     attempts: tuple = ()
+    system: object = None
 
     def statespace(self):
         """The filter as a discrete :class:`control.StateSpace` (y → z_f)."""
@@ -287,6 +291,7 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
         sample_norms=norms, alphas=alphas, worst_sample=k, spectral_radius=float(np.max(radii)),
         lyapunov=lyapunov, form=form, covers=COVERS[lyapunov], witness=witness, solver=slv,
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
+        system=system,
     )
 
 
@@ -324,6 +329,7 @@ def observer_nominal(system, dt, solvers, t_start):
     uncertainty). The certificate is (E1) in error coordinates and the norm of
     the error-coordinate system; the witness is in ``variables``.
     """
+    system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, dt=1.0 if dt is True else dt)
     poly = PolytopicSystem((system,), system.dt)
     res = synthesize_polytopic(poly, lyapunov="common", form="observer", solver=solvers[0] if len(solvers) == 1 else None)
     return SynthesisResult(
@@ -334,5 +340,5 @@ def observer_nominal(system, dt, solvers, t_start):
         variables={"P": res.witness["P"], "G": res.witness["G"], "lyapunov": "common",
                    "coordinates": "estimation error e = x + x_f (observer form)"},
         attempts=res.attempts + ("nominal observer form in error coordinates: the plant need not be stable",),
-        samples=(None,), form="observer",
+        samples=(None,), form="observer", system=system,
     )

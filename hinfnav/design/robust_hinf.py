@@ -442,6 +442,7 @@ def synthesize(
             deltas=None if sample_set is None else sample_set.values,
             form=form,
             sample_labels=() if sample_set is None else sample_set.labels,
+            system=dataclasses.replace(system, dt=1.0 if dt_value is True else dt_value),
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
         hint = infeasibility_hint(system.A, system.H, system.E, structure, form)

@@ -26,6 +26,7 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .files import read_system_file
 from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
@@ -54,4 +55,5 @@ __all__ = [
     "PolytopicSystem",
     "simplex_grid",
     "two_mass_spring",
+    "read_system_file",
 ]
