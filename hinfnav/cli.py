@@ -93,7 +93,9 @@ def _cmd_design_own(args):
              f"  worst sampled H-infinity norm {rep['sampled_worst_norm']:.10g} over {rep['n_samples']} samples",
              f"  covers: {rep['covers']}"] + [f"  refused: {r}" for r in rep["reasons"]]))
         if not rep["ok"]:
-            raise SystemExit(1)
+            from .core.exceptions import CertificationError
+
+            raise CertificationError(f"design file {rep['path']} is not recertified: " + "; ".join(rep["reasons"]))
         return
     if args.gamma is not None:
         raise InputError("--gamma applies to --objective h2 of the built-in scenario only")
