@@ -8,6 +8,7 @@ from ..lmi.solve import SOLVERS, SolverOptions
 from .from_file import design_from_system_file, design_summary
 from .io import check_design_system, load_design, save_design, system_fingerprint
 from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
+from .compare import compare_uncertainty_models
 from .explain import small_gain_number
 from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
 from .recertify import recertify
@@ -42,4 +43,5 @@ __all__ = [
     "recertify",
     "design_from_system_file",
     "design_summary",
+    "compare_uncertainty_models",
 ]

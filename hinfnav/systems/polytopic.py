@@ -142,6 +142,21 @@ class PolytopicSystem:
         return tuple(k for k in MATRIX_KEYS if any(not np.array_equal(getattr(v, k), getattr(v0, k))
                                                    for v in self.vertices[1:]))
 
+    def norm_bounded_cover(self):
+        """A norm-bounded ``A₀ + H F E`` (FᵀF ≤ I) containing a two-vertex polytope in which only A varies.
+
+        ``A₀`` is the midpoint and ``H F E`` with ``H = U Σ``, ``E = Vᵀ`` (the
+        SVD of half the difference, rank r) contains ``±(A₁ − A₀)/2`` (F = ±I):
+        exact when r = 1 (F a scalar in [−1, 1]), a cover otherwise. Returns
+        an :class:`UncertainSystem`.
+        """
+        if self.n_vertices != 2 or set(self.varying()) - {"A"}:
+            raise InputError("norm_bounded_cover needs two vertices that differ in A only")
+        v0, v1 = self.vertices
+        U, sv, Vt = np.linalg.svd((v1.A - v0.A) / 2.0)
+        r = max(1, int(np.sum(sv > 1e-12 * max(sv[0], np.finfo(float).tiny))))
+        return UncertainSystem((v0.A + v1.A) / 2.0, v0.B, v0.C, v0.D, v0.L, U[:, :r] * sv[:r], Vt[:r], dt=self.dt)
+
     def at(self, alpha):
         """The nominal system at the convex weights ``alpha`` (shape (N,), ≥ 0, summing to 1)."""
         a = np.asarray(alpha, dtype=float)
