@@ -60,11 +60,11 @@ def unstable_plant_message(rho, where):
     """Why a plant that is not (robustly) Schur stable has no general-form design, and what would help."""
     return (
         f"the plant is not robustly Schur stable: its state matrix has spectral radius {rho:.12g} >= 1 at {where}. "
-        "The error system of a general-form filter carries the plant state x "
+        "Lemma 1 bounds the error system, and the error system of a general-form filter carries the plant state x "
         "(Ā = [[A + ΔA, 0], [B_F C, A_F]] is block triangular, so its eigenvalues include those of A + ΔA), "
         "and with uncertainty the estimation error contains ΔA x, driven by a growing x: no filter makes it "
         "stable and no finite γ exists. What helps: form='observer' when the plant is only detectable and the "
         "uncertainty does not multiply the plant state (no ΔA, no ΔC: nominal, or uncertain B, D only); "
-        "designing on a stabilized plant (a closed loop u = K x, A + G K) when the input is known; or a smaller "
+        "designing on a stabilized plant (a closed loop u = Kx, A + G K) when the input is known; or a smaller "
         "uncertainty."
     )
