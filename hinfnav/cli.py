@@ -104,7 +104,8 @@ def _cmd_design_own(args):
     if args.save:
         rep["saved_to"] = str(save_design(result, result.system, args.save, options={"system_file": args.system}))
     print(json.dumps(rep, indent=2) if args.json else "\n".join(
-        [f"certified gamma {rep['gamma']:.10g} (solver {rep['lmi_gamma']:.10g}), worst sampled norm "
+        [f"certified {'H2 bound' if rep['objective'] == 'h2' else 'gamma'} {rep['gamma']:.10g} (solver "
+         f"{rep['lmi_gamma']:.10g}), worst sampled norm "
          f"{rep['verified_worst_norm']:.10g} over {rep['n_samples']} samples",
          f"  Lyapunov: {rep['lyapunov']}, form: {rep['form']}; covers {rep['covers']}"]
         + ([f"  saved to {rep['saved_to']}"] if args.save else [])))

@@ -116,3 +116,14 @@ def test_latin1_system_file_is_a_clear_error(tmp_path, capsys):
     f.write_bytes("dt = 0.1 # café\n".encode("latin-1"))
     rc, _, err = run_cli(capsys, "design", "--system", str(f))
     assert rc == 2 and "UTF-8" in err and "latin1.toml" in err
+
+
+def test_h2_design_from_file_saves_and_recertifies(tmp_path, capsys):
+    save = tmp_path / "h2.json"
+    rc, out, err = run_cli(capsys, "design", "--system", str(ROOT / "examples" / "double_integrator.toml"), "--form",
+                           "observer", "--objective", "h2", "--json", "--save", str(save))
+    assert rc == 0, err
+    rep = json.loads(out)
+    assert rep["objective"] == "h2" and rep["verified_worst_norm"] <= rep["gamma"]
+    again = hn.recertify(save)
+    assert again["ok"] and again["objective"] == "h2", again["reasons"]

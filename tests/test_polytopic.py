@@ -114,3 +114,26 @@ def test_norm_bounded_infeasibility_gives_the_small_gain_number():
     nb = _rank_one(two_mass_spring(0.3, c=0.2))
     with pytest.raises(InfeasibleLMIError, match=r"‖E\(zI − A\)⁻¹H‖∞ = [0-9.]+ ≥ 1.*parameter-dependent"):
         hn.synthesize(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E, solver="CLARABEL")
+
+
+def test_h2_double_integrator_matches_the_kalman_predictor():
+    import scipy.linalg
+
+    poly = PolytopicSystem((UncertainSystem(A_DI, B_DI, C_DI, D_DI, np.eye(4), dt=T),), T)
+    res = hn.synthesize_polytopic(poly, lyapunov="common", form="observer", objective="h2")
+    # independent: the optimal H2 observer is the steady Kalman predictor (Q = B Bᵀ, R = D Dᵀ); its error's
+    # H2 norm squared is trace(P), P the a-priori DARE solution (scipy)
+    P = scipy.linalg.solve_discrete_are(A_DI.T, C_DI.T, B_DI @ B_DI.T, D_DI @ D_DI.T)
+    h2_opt = float(np.sqrt(np.trace(P)))
+    assert res.verified_norm <= res.gamma * (1 + 1e-9)
+    assert h2_opt * (1 - 1e-9) <= res.verified_norm <= h2_opt * (1 + 1e-4)  # solver accuracy
+    assert res.gamma <= h2_opt * (1 + 1e-4)
+
+
+def test_h2_polytope_pdl_not_above_common():
+    poly = two_mass_spring(0.1, c=0.2)
+    g_q = hn.synthesize_polytopic(poly, lyapunov="common", objective="h2")
+    g_pdl = hn.synthesize_polytopic(poly, lyapunov="parameter-dependent", objective="h2")
+    assert g_pdl.gamma <= g_q.gamma * (1 + ORDER_RTOL)
+    for r in (g_q, g_pdl):
+        assert r.objective == "h2" and r.verified_norm <= r.gamma

@@ -10,7 +10,6 @@ polytopes go to :func:`~hinfnav.design.synthesize_polytopic`.
 
 import numpy as np
 
-from ..core.exceptions import InputError
 from ..core.provenance import provenance
 from ..core.validation import as_choice
 from ..systems.files import read_system_file
@@ -36,6 +35,7 @@ def design_summary(result):
         "lmi_gamma": float(result.lmi_gamma),
         "verified_worst_norm": float(result.verified_norm),
         "n_samples": int(np.size(result.sample_norms)),
+        "objective": getattr(result, "objective", "hinf"),
         "lyapunov": lyapunov,
         "form": result.form,
         "covers": covers,
@@ -55,8 +55,10 @@ def design_from_system_file(path, *, lyapunov=None, form="general", objective="h
     lyapunov : {"common", "parameter-dependent"}, optional
         Default: parameter-dependent for a polytope, common otherwise.
     form : {"general", "observer"}
-    objective : {"hinf"}
-        ``"h2"`` is refused (not implemented for systems from files).
+    objective : {"hinf", "h2"}
+        ``"h2"``: the extended H2 LMIs (E2) on the polytope (a norm-bounded
+        system as its sign-vertex polytope, F diagonal; a nominal one as one
+        vertex); the summary's ``gamma`` is then the certified H2 bound.
     solver : str, optional
 
     Returns
@@ -65,14 +67,16 @@ def design_from_system_file(path, *, lyapunov=None, form="general", objective="h
         The result (with its ``system``) and :func:`design_summary`.
     """
     objective = as_choice("objective", objective, ("hinf", "h2"))
-    if objective == "h2":
-        raise InputError("--objective h2 is not available with --system yet (only hinf); the mixed H2/H∞ design "
-                         "exists for the built-in scenario only")
     if lyapunov is not None:
         lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
     form = as_choice("form", form, ("general", "observer"))
     system = read_system_file(path)
-    if isinstance(system, PolytopicSystem):
+    if objective == "h2":  # H2: the extended LMIs (E2) on the polytope (one vertex when nominal)
+        if not isinstance(system, PolytopicSystem):
+            system = PolytopicSystem.from_norm_bounded(system)
+        lyapunov = lyapunov or ("parameter-dependent" if system.n_vertices > 1 else "common")
+        result = synthesize_polytopic(system, lyapunov=lyapunov, form=form, solver=solver, objective="h2")
+    elif isinstance(system, PolytopicSystem):
         result = synthesize_polytopic(system, lyapunov=lyapunov or "parameter-dependent", form=form, solver=solver)
     elif system.H is not None and lyapunov == "parameter-dependent":
         result = synthesize_polytopic(PolytopicSystem.from_norm_bounded(system), lyapunov=lyapunov, form=form,

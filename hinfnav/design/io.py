@@ -94,10 +94,10 @@ def design_to_dict(result, system, *, options=None, extra=None):
     }
     if polytopic:
         cert.update(lyapunov=result.lyapunov, covers=result.covers, alphas=np.asarray(result.alphas).tolist(),
-                    method="minimize")
+                    method="minimize", objective=result.objective)
         sysd = {"kind": "polytope", "dt": dt, "labels": list(system.labels),
                 "vertices": [{k: getattr(v, k).tolist() for k in MATRIX_KEYS} for v in system.vertices]}
-        witness = {"P": _plain(result.witness["P"]), "G": _plain(result.witness["G"])}
+        witness = {k: _plain(v) for k, v in result.witness.items()}
     else:
         cert.update(
             method=result.method, structure=result.structure,
@@ -167,8 +167,9 @@ def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
         verified_norm=float(c["verified_norm"]), sample_norms=np.asarray(c.get("sample_norms", []), dtype=float),
         alphas=np.asarray(c.get("alphas", []), dtype=float), worst_sample=int(c.get("worst_sample", 0)),
         spectral_radius=float(c["spectral_radius"]), lyapunov=str(c["lyapunov"]), form=str(c["form"]),
-        covers=str(c["covers"]), witness={"P": [np.asarray(P, dtype=float) for P in w.get("P", [])],
-                                          "G": np.asarray(w.get("G", []), dtype=float)},
+        covers=str(c["covers"]), objective=str(c.get("objective", "hinf")),
+        witness=dict({k: np.asarray(v, dtype=float) for k, v in w.items() if k != "P"},
+                     P=[np.asarray(P, dtype=float) for P in w.get("P", [])]),
         solver=str(c.get("solver")), solve_time_s=float(c.get("solve_time_s", 0.0)),
         total_time_s=float(c.get("total_time_s", 0.0)), dt=float(f["dt"]),
     )

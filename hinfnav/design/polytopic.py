@@ -28,13 +28,13 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
-from ..analysis.certificates import schur_gamma
+from ..analysis.certificates import certify_negative_definite, schur_gamma
 from ..analysis.error_system import worst_case_norm
-from ..analysis.norms import hinf_norm
+from ..analysis.norms import h2_norm, hinf_norm
 from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
-from ..lmi.polytopic import extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
+from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
@@ -86,6 +86,9 @@ class PolytopicResult:
     attempts : tuple of str
     system : PolytopicSystem or None
         The polytope the filter was designed for.
+    objective : {"hinf", "h2"}
+        With ``"h2"``, ``gamma``, ``lmi_gamma``, ``verified_norm`` and
+        ``sample_norms`` are H2 norms (bound and sampled), ``witness`` has W.
     """
 
     A_F: np.ndarray
@@ -108,6 +111,7 @@ class PolytopicResult:
     dt: float = 1.0
     attempts: tuple = ()
     system: object = None
+    objective: str = "hinf"
 
     def statespace(self):
         """The filter as a discrete :class:`control.StateSpace` (y → z_f)."""
@@ -146,6 +150,8 @@ def certify_polytopic(system, A_F, B_F, C_F, witness, form="general"):
         for every γ).
     per_vertex : list of float
     """
+    if "W" in witness:
+        return _certify_h2(system, A_F, B_F, C_F, witness, form)
     P_list, G = witness["P"], np.asarray(witness["G"], dtype=float)
     if len(P_list) != system.n_vertices:
         raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
@@ -162,7 +168,31 @@ def certify_polytopic(system, A_F, B_F, C_F, witness, form="general"):
     return max(per), per
 
 
-def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None):
+def _certify_h2(system, A_F, B_F, C_F, witness, form):
+    """Certified H2 bound from (E2) in float64: both matrices positive definite at every vertex (internal)."""
+    P_list, G, W = witness["P"], np.asarray(witness["G"], dtype=float), np.asarray(witness["W"], dtype=float)
+    if len(P_list) != system.n_vertices:
+        raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
+    scale = max(abs(np.trace(W)), np.finfo(float).tiny)
+    for eps in (0.0, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4):
+        Wc = W + eps * scale * np.eye(W.shape[0])
+        ok = True
+        for vert, P in zip(_vertex_tuples(system), P_list):
+            Abar, Bbar, Cbar = error_coordinates(vert, A_F, B_F, C_F, form)
+            P = np.asarray(P, dtype=float)
+            if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape or Wc.shape != (Bbar.shape[1],) * 2:
+                raise InputError("the witness's P, G or W does not fit the error system's dimensions")
+            M1, M2 = extended_h2_matrices(P, G @ Abar, G @ Bbar, Cbar, G, Wc)
+            if not (certify_negative_definite(-M1)[0] and certify_negative_definite(-M2)[0]):
+                ok = False
+                break
+        if ok:
+            g = float(np.sqrt(max(np.trace(Wc), 0.0)))
+            return g, [g] * system.n_vertices
+    return float("inf"), [float("inf")] * system.n_vertices
+
+
+def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None, objective="hinf"):
     """H∞ norms of the error system at convex weights ``alphas`` (default: :func:`simplex_grid`).
 
     Returns ``(norms, spectral_radii, alphas)``.
@@ -173,7 +203,11 @@ def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None):
     norms, radii = [], []
     for a in alphas:
         s = system.at(a)
-        if form == "observer":
+        if objective == "h2":
+            Ab, Bb, Cb = error_coordinates((s.A, s.B, s.C, s.D, s.L), A_F, B_F, C_F, form)
+            radii.append(spectral_radius(Ab))
+            norms.append(h2_norm(control.ss(Ab, Bb, Cb, np.zeros((Cb.shape[0], Bb.shape[1])), True)))
+        elif form == "observer":
             Ab, Bb, Cb = error_coordinates((s.A, s.B, s.C, s.D, s.L), A_F, B_F, C_F, form)
             radii.append(spectral_radius(Ab))
             norms.append(hinf_norm(control.ss(Ab, Bb, Cb, np.zeros((Cb.shape[0], Bb.shape[1])), True)))
@@ -201,7 +235,7 @@ def _check(system, form):
 
 
 def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="general", solver=None, grid_points=None,
-                         seed=0):
+                         seed=0, objective="hinf"):
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters
@@ -223,6 +257,9 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
         two vertices, 200 plus 20 random points otherwise).
     seed : int, optional
         Seed of the random simplex points.
+    objective : {"hinf", "h2"}, optional
+        ``"h2"``: minimize the H2 bound ``tr W`` of the extended H2 LMIs (E2)
+        instead (same filter parametrization; the result's norms are H2).
 
     Returns
     -------
@@ -237,6 +274,7 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
         raise InputError(f"system must be a hinfnav PolytopicSystem; got {type(system).__name__}")
     lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
     form = as_choice("form", form, ("general", "observer"))
+    objective = as_choice("objective", objective, ("hinf", "h2"))
     solvers = ("CLARABEL", "CVXOPT") if solver is None else (as_choice("solver", str(solver).upper(), SOLVERS),)
     if not np.any([np.any(v.L) for v in system.vertices]):
         raise InputError("L is zero at every vertex: the estimated signal z = L x is identically 0, so there is "
@@ -250,7 +288,7 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
     verts = _vertex_tuples(system)
     log, statuses, best, seconds = [], [], None, 0.0
     for slv in solvers:
-        sol = solve_polytopic_hinf(verts, form, lyapunov, slv)
+        sol = solve_polytopic_hinf(verts, form, lyapunov, slv, objective=objective)
         seconds += sol["seconds"]
         statuses.append(f"{slv} {sol['status']}")
         if "P" not in sol:
@@ -258,14 +296,15 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
             continue
         tries = [sol]
         g_s = float(np.sqrt(max(sol["gamma2"], 0.0)))
-        cand = _rebuild_and_certify(system, sol, form, alphas)
+        cand = _rebuild_and_certify(system, sol, form, alphas, objective)
         log.append(f"{slv} minimize: status {sol['status']}, solver γ = {g_s:.10g}, certified γ = {cand[0]:.10g}")
         if not cand[-1] or cand[0] > g_s * (1 + 1e-3):
             for step in (1e-5, 1e-4, 1e-3, 1e-2, 1e-1):  # an interior point just above the solver's level certifies better
-                sol2 = solve_polytopic_hinf(verts, form, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2)
+                sol2 = solve_polytopic_hinf(verts, form, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2,
+                                            objective=objective)
                 seconds += sol2["seconds"]
                 if "P" in sol2 and sol2["margin"] > 0:
-                    c2 = _rebuild_and_certify(system, sol2, form, alphas)
+                    c2 = _rebuild_and_certify(system, sol2, form, alphas, objective)
                     log.append(f"{slv} feasibility at γ = {g_s * (1 + step):.10g}: certified γ = {c2[0]:.10g}")
                     if c2[-1] and (not cand[-1] or c2[0] < cand[0]):
                         cand, tries = c2, [sol2]
@@ -280,10 +319,10 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
                     "lyapunov='parameter-dependent' only asks for α constant in time and is less conservative."
                     if lyapunov == "common" and N > 1 else
                     " Reduce the uncertainty (a smaller polytope) or check that the plant is detectable from y.")
-            raise InfeasibleLMIError("no solver found a solution of the extended H∞ LMIs (E1) at the vertices: "
+            raise InfeasibleLMIError("no solver found a solution of the extended LMIs ((E1) for H∞, (E2) for H2) at the vertices: "
                                      "infeasible, or too ill-conditioned to solve (solver status: "
                                      + "; ".join(statuses) + ")." + hint)
-        raise CertificationError("no solution of the extended LMIs (E1) passed certification: " + " | ".join(log))
+        raise CertificationError("no solution of the extended LMIs passed certification: " + " | ".join(log))
     (gamma_c, A_F, B_F, C_F, witness, norms, radii, ok), sol, slv, g_s = best
     k = int(np.argmax(norms))
     return PolytopicResult(
@@ -291,11 +330,11 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
         sample_norms=norms, alphas=alphas, worst_sample=k, spectral_radius=float(np.max(radii)),
         lyapunov=lyapunov, form=form, covers=COVERS[lyapunov], witness=witness, solver=slv,
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
-        system=system,
+        system=system, objective=objective,
     )
 
 
-def _rebuild_and_certify(system, sol, form, alphas):
+def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):
     """Filter from the solver's variables, (E1) in float64, sampled norms; a tuple ending in ok (internal)."""
     fail = (float("inf"), None, None, None, None, None, None, False)
     if form == "observer":
@@ -311,10 +350,12 @@ def _rebuild_and_certify(system, sol, form, alphas):
             return fail
         A_F, B_F, C_F = np.linalg.solve(V, sol["Ahat"]), np.linalg.solve(V, sol["Bhat"]), sol["C_F"].copy()
     witness = {"P": [np.array(P) for P in sol["P"]], "G": np.array(sol["G"])}
+    if objective == "h2":
+        witness["W"] = 0.5 * (sol["W"] + sol["W"].T)
     gamma_c, _ = certify_polytopic(system, A_F, B_F, C_F, witness, form)
     if not np.isfinite(gamma_c):
         return fail
-    norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, alphas)
+    norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, alphas, objective)
     ok = bool(np.all(radii < 1.0) and np.max(norms) <= gamma_c * (1 + 1e-9))
     return gamma_c, A_F, B_F, C_F, witness, norms, radii, ok
 

@@ -79,10 +79,12 @@ def recertify(path):
     result, system, d = load_design(path)
     reasons = []
     if isinstance(result, PolytopicResult):
-        levels = {"extended BRL (E1) at every vertex": certify_polytopic(system, result.A_F, result.B_F, result.C_F,
-                                                                         result.witness, result.form)[0]}
+        name = "extended H2 LMIs (E2)" if result.objective == "h2" else "extended BRL (E1)"
+        levels = {f"{name} at every vertex": certify_polytopic(system, result.A_F, result.B_F, result.C_F,
+                                                               result.witness, result.form)[0]}
         alphas = result.alphas if np.size(result.alphas) else None
-        norms, radii, _ = sampled_norms(system, result.A_F, result.B_F, result.C_F, result.form, alphas)
+        norms, radii, _ = sampled_norms(system, result.A_F, result.B_F, result.C_F, result.form, alphas,
+                                        result.objective)
     else:
         levels = _lmi_levels(result, system)
         if "G" in result.variables:
@@ -102,7 +104,7 @@ def recertify(path):
     if not np.all(np.asarray(radii) < 1.0):
         reasons.append("the error system is not Schur stable at some sample")
     if worst > result.gamma * (1 + 1e-9):
-        reasons.append(f"a sampled H∞ norm {worst:.10g} exceeds the stored γ = {result.gamma:.10g}")
+        reasons.append(f"a sampled norm {worst:.10g} exceeds the stored bound {result.gamma:.10g}")
     return {
         "ok": not reasons,
         "path": str(path),
@@ -112,5 +114,6 @@ def recertify(path):
         "sampled_worst_norm": worst,
         "n_samples": int(np.size(norms)),
         "covers": d["certificate"].get("covers", ""),
+        "objective": getattr(result, "objective", "hinf"),
         "reasons": reasons,
     }

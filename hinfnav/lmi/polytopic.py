@@ -42,7 +42,8 @@ import numpy as np
 
 from .solve import solver_kwargs
 
-__all__ = ["extended_hinf_matrix", "hinf_gamma_index", "solve_polytopic_hinf", "filter_slack_products"]
+__all__ = ["extended_hinf_matrix", "hinf_gamma_index", "solve_polytopic_hinf", "filter_slack_products",
+           "extended_h2_matrices"]
 
 
 def extended_hinf_matrix(P, GA, GB, Cbar, G, gamma2, bmat=np.block):
@@ -59,6 +60,25 @@ def extended_hinf_matrix(P, GA, GB, Cbar, G, gamma2, bmat=np.block):
         [GB.T, Z((k, N)), gamma2 * I(k), Z((k, l))],
         [Z((l, N)), Cbar, Z((l, k)), I(l)],
     ])
+
+
+def extended_h2_matrices(P, GA, GB, Cbar, G, W, bmat=np.block):
+    """The two matrices of the extended H2 LMIs (E2), both positive definite iff ``‖·‖₂² < tr W`` holds with P.
+
+    ``Āᵀ P Ā − P + C̄ᵀC̄ < 0`` and ``W > B̄ᵀ P B̄`` (P bounds the observability
+    Gramian, ``‖C̄(zI − Ā)⁻¹B̄‖₂² = tr B̄ᵀ Q B̄``), in the extended form of de
+    Oliveira, Geromel & Bernussou (2002) (``G P⁻¹ Gᵀ ≥ G + Gᵀ − P``)::
+
+        [ G + Gᵀ − P   G Ā   0  ]                [ W      (G B̄)ᵀ     ]
+        [  *           P     C̄ᵀ ]  > 0,          [ G B̄   G + Gᵀ − P ]  > 0
+        [  *           *     I  ]
+    """
+    N, k = GB.shape
+    l = Cbar.shape[0]
+    Z, I = np.zeros, np.eye
+    M1 = bmat([[G + G.T - P, GA, Z((N, l))], [GA.T, P, Cbar.T], [Z((l, N)), Cbar, I(l)]])
+    M2 = bmat([[W, GB.T], [GB, G + G.T - P]])
+    return M1, M2
 
 
 def hinf_gamma_index(N, k):
@@ -78,7 +98,7 @@ def filter_slack_products(vertex, X, Z, V, Ahat, Bhat, CF, bmat=np.block):
 
 
 def solve_polytopic_hinf(vertices, form="general", lyapunov="parameter-dependent", solver="CLARABEL",
-                         margin=1e-8, accuracy=1e-8, bound=1e6, gamma2=None):
+                         margin=1e-8, accuracy=1e-8, bound=1e6, gamma2=None, objective="hinf"):
     """Minimize γ² subject to (E1) at every vertex; one cvxpy solve.
 
     Parameters
@@ -95,6 +115,9 @@ def solve_polytopic_hinf(vertices, form="general", lyapunov="parameter-dependent
     gamma2 : float, optional
         Feasibility at this level, maximizing the margin, instead of the
         minimization.
+    objective : {"hinf", "h2"}
+        ``"h2"``: minimize ``tr W`` subject to (E2) instead (``gamma2`` is
+        then the H2 bound squared; returned ``W``).
 
     Returns
     -------
@@ -132,10 +155,21 @@ def solve_polytopic_hinf(vertices, form="general", lyapunov="parameter-dependent
         Ps = [cp.Variable((N, N), symmetric=True)] * nv
     else:
         Ps = [cp.Variable((N, N), symmetric=True) for _ in range(nv)]
+    if objective == "h2":
+        k = prods[0][1].shape[1]
+        W = cp.Variable((k, k), symmetric=True)
+        raw["W"] = W
+        if gamma2 is None:
+            g = cp.trace(W)
+        else:
+            cons.append(cp.trace(W) <= float(gamma2))
     for P, (GA, GB, Cbar) in zip(Ps, prods):
-        M = extended_hinf_matrix(P, GA, GB, Cbar, G, g, bmat=cp.bmat)
-        size = M.shape[0]
-        cons.append(0.5 * (M + M.T) >> t * np.eye(size))
+        if objective == "h2":
+            mats = extended_h2_matrices(P, GA, GB, Cbar, G, W, bmat=cp.bmat)
+        else:
+            mats = (extended_hinf_matrix(P, GA, GB, Cbar, G, g, bmat=cp.bmat),)
+        for M in mats:
+            cons.append(0.5 * (M + M.T) >> t * np.eye(M.shape[0]))
     for P in (Ps[:1] if lyapunov == "common" else Ps):
         cons.append(P << bound * np.eye(N))
     if gamma2 is None:
