@@ -38,7 +38,7 @@ from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gam
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
-from .explain import unstable_plant_message
+from .explain import small_gain_number, unstable_plant_message
 from .result import SynthesisResult
 
 __all__ = ["LYAPUNOV", "COVERS", "PolytopicResult", "synthesize_polytopic", "certify_polytopic",
@@ -319,6 +319,11 @@ def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="genera
                     "lyapunov='parameter-dependent' only asks for α constant in time and is less conservative."
                     if lyapunov == "common" and N > 1 else
                     " Reduce the uncertainty (a smaller polytope) or check that the plant is detectable from y.")
+            if N == 2 and set(system.varying()) <= {"A"}:
+                nb = system.norm_bounded_cover()
+                hint += (f" The small-gain number of the polytope written as A₀ + H F E (‖E(zI − A₀)⁻¹H‖∞, H of rank "
+                         f"{nb.H.shape[1]}) is {small_gain_number(nb.A, nb.H, nb.E):.4g}: at or above 1 no single "
+                         "quadratic Lyapunov function exists for time-varying F.")
             raise InfeasibleLMIError("no solver found a solution of the extended LMIs ((E1) for H∞, (E2) for H2) at the vertices: "
                                      "infeasible, or too ill-conditioned to solve (solver status: "
                                      + "; ".join(statuses) + ")." + hint)
