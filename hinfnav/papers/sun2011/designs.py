@@ -460,6 +460,9 @@ def load_design(path, scenario=None):
     if scenario is None and (d.get("extra") or {}).get("paper") != "sun2011":
         return result  # a design of another system: checked against its own fingerprint only
     scenario = _scenario(scenario)
+    if not isinstance(result, SynthesisResult):
+        raise InputError(f"design file {path} was made for another system (a polytope of "
+                         f"{getattr(system, 'n_vertices', '?')} vertices), not for the scenario: design again for it")
     delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
     design_io.check_design_system(system, system.dt, scenario.design_model(delta_bar), scenario.dt,
                                   what="the scenario")
