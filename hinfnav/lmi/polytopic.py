@@ -1,9 +1,12 @@
 """Extended (slack-variable) H∞ LMIs for filters on polytopes, and one cvxpy solve.
 
-The discrete bounded real lemma in its extended form (de Oliveira, Geromel &
-Bernussou 2002, Theorem 3, written for the primal Lyapunov inequality; the
-same form underlies the polytopic filters of Geromel, de Oliveira &
-Bernussou 2002 and Xie, Lu, Zhang & Zhang 2004): the system
+The discrete bounded real lemma in its extended (slack-variable) form, in the
+manner of de Oliveira, Geromel & Bernussou (2002) and of the polytopic filters
+of Xie, Lu, Zhang & Zhang (2004) and Duan et al. (2006); written here for the
+primal Lyapunov inequality and derived below (the theorem numbering and the
+exact block order of those papers were not checked against the originals,
+which are not in the workbook: the float64 certificate of every returned
+filter is what vouches for it): the system
 ``ξ⁺ = Ā ξ + B̄ τ``, ``e = C̄ ξ`` is Schur stable with ``‖C̄(zI − Ā)⁻¹B̄‖∞ < γ``
 iff there are ``P = Pᵀ`` and a slack ``G`` (not symmetric) with::
 
