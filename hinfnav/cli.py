@@ -61,6 +61,10 @@ def _cmd_simulate(args):
 def _cmd_design(args):
     if args.save is not None:  # before the heavy imports and the solver: an empty path, a folder, a missing folder
         check_new_file("--save", args.save, example="design.json")
+    if args.recertify is not None or args.system is not None:
+        return _cmd_design_own(args)
+    if args.lyapunov is not None:
+        raise InputError("--lyapunov applies to --system only")
     from .papers.sun2011.designs import design_for_scenario, design_report_from, format_design_report, save_design
 
     if getattr(args, "objective", "hinf") == "h2":
@@ -72,6 +76,39 @@ def _cmd_design(args):
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
     print(json.dumps(rep, indent=2) if args.json else format_design_report(rep))
+
+
+def _cmd_design_own(args):
+    """``design --system FILE`` (a system of one's own) or ``design --recertify FILE`` (issue 19)."""
+    from .design import design_from_system_file, recertify
+    from .design.io import save_design
+
+    if args.recertify is not None:
+        if args.system is not None or args.save is not None:
+            raise InputError("--recertify takes a design file alone (no --system, no --save)")
+        rep = recertify(args.recertify)
+        print(json.dumps(rep, indent=2) if args.json else "\n".join(
+            [f"design file {rep['path']}: {'RECERTIFIED' if rep['ok'] else 'NOT RECERTIFIED'}",
+             f"  stored gamma {rep['gamma']:.10g}; LMI witness re-evaluated in float64: {rep['lmi_gamma_recomputed']:.10g}",
+             f"  worst sampled H-infinity norm {rep['sampled_worst_norm']:.10g} over {rep['n_samples']} samples",
+             f"  covers: {rep['covers']}"] + [f"  refused: {r}" for r in rep["reasons"]]))
+        if not rep["ok"]:
+            from .core.exceptions import CertificationError
+
+            raise CertificationError(f"design file {rep['path']} is not recertified: " + "; ".join(rep["reasons"]))
+        return
+    if args.gamma is not None:
+        raise InputError("--gamma applies to --objective h2 of the built-in scenario only")
+    result, rep = design_from_system_file(args.system, lyapunov=args.lyapunov, form=args.form,
+                                          objective=args.objective, solver=args.solver)
+    if args.save:
+        rep["saved_to"] = str(save_design(result, result.system, args.save, options={"system_file": args.system}))
+    print(json.dumps(rep, indent=2) if args.json else "\n".join(
+        [f"certified {'H2 bound' if rep['objective'] == 'h2' else 'gamma'} {rep['gamma']:.10g} (solver "
+         f"{rep['lmi_gamma']:.10g}), worst sampled norm "
+         f"{rep['verified_worst_norm']:.10g} over {rep['n_samples']} samples",
+         f"  Lyapunov: {rep['lyapunov']}, form: {rep['form']}; covers {rep['covers']}"]
+        + ([f"  saved to {rep['saved_to']}"] if args.save else [])))
 
 
 def _cmd_design_h2(args, save_design):
@@ -166,6 +203,14 @@ def _parser():
     d.add_argument("--gamma", type=float, default=None,
                    help="with --objective h2: the H-infinity bound (above gamma* of Corollary 1)")
     d.add_argument("--points", type=int, default=12, help="with --objective h2 and no --gamma: front points (default 12)")
+    d.add_argument("--system", metavar="SYS.toml", default=None,
+                   help="design for your own system from a TOML file (dt, [nominal] A B C D L, optional "
+                        "[uncertainty] norm-bounded H E or polytope vertices) instead of the built-in scenario")
+    d.add_argument("--lyapunov", default=None, choices=("common", "parameter-dependent"),
+                   help="with --system: one Lyapunov matrix (time-varying uncertainty) or one per vertex "
+                        "(constant uncertainty; default for a polytope)")
+    d.add_argument("--recertify", metavar="FILE", default=None,
+                   help="re-check a saved design file in float64 without a solver (LMI witness and sampled norms)")
     d.add_argument("--json", action="store_true", help="print one JSON object")
     d.set_defaults(func=_cmd_design)
 

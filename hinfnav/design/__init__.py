@@ -5,8 +5,13 @@ the solver reported.
 """
 
 from ..lmi.solve import SOLVERS, SolverOptions
+from .from_file import design_from_system_file, design_summary
 from .io import check_design_system, load_design, save_design, system_fingerprint
 from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
+from .compare import compare_uncertainty_models
+from .explain import small_gain_number
+from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
+from .recertify import recertify
 from .result import SynthesisResult
 from .robust_hinf import FORMS, synthesize
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
@@ -31,4 +36,12 @@ __all__ = [
     "load_design",
     "check_design_system",
     "system_fingerprint",
+    "synthesize_polytopic",
+    "certify_polytopic",
+    "PolytopicResult",
+    "small_gain_number",
+    "recertify",
+    "design_from_system_file",
+    "design_summary",
+    "compare_uncertainty_models",
 ]

@@ -1,9 +1,13 @@
 """Designs as files: save a certified filter with the system it was designed for, load it back.
 
 A design file (JSON) holds the filter (A_F, B_F, C_F), its certified γ and the
-solver's γ, the certification numbers, the uncertain system ψ_d it was
-designed for with a fingerprint of its matrices and sampling time, the
-options and provenance. :func:`load_design` refuses a file whose system does
+solver's γ, the certification numbers, the system it was designed for
+(norm-bounded ψ_d or a polytope of vertices), the LMI witness (the Lyapunov
+and slack variables the certificate was evaluated at), the options and
+provenance, and a SHA-256 fingerprint of the filter, the certificate, the
+system and the witness together: a file with any of them edited is refused
+(:func:`design_from_dict`). :func:`recertify` re-checks a file without a
+solver. :func:`load_design` refuses a file whose system does
 not match the one it is loaded for, naming what differs (another T, another
 B …), so a filter is never run on a system it was not designed and certified
 for.
@@ -17,14 +21,16 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.provenance import provenance
 from ..core.validation import as_path, check_new_file
+from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
 from ..systems.uncertain import UncertainSystem
+from .polytopic import PolytopicResult
 from .result import SynthesisResult
 
-__all__ = ["FORMAT", "system_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
+__all__ = ["FORMAT", "system_fingerprint", "content_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
            "check_design_system", "check_design_path"]
 
 #: Identifier and version of the file format.
-FORMAT = "hinfnav-design/1"
+FORMAT = "hinfnav-design/2"
 
 _MATRICES = ("A", "B", "C", "D", "L", "H", "E")
 
@@ -48,38 +54,73 @@ def system_fingerprint(system, dt):
     return h.hexdigest()
 
 
+def _plain(v):
+    """JSON-ready copy of a witness entry (arrays to nested lists)."""
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    return v
+
+
+def content_fingerprint(d):
+    """SHA-256 of a design file's filter, certificate, system and witness (canonical JSON; floats exact)."""
+    body = {k: d.get(k) for k in ("format", "filter", "certificate", "system", "witness")}
+    return hashlib.sha256(json.dumps(body, sort_keys=True, allow_nan=True).encode()).hexdigest()
+
+
 def design_to_dict(result, system, *, options=None, extra=None):
-    """JSON-ready dict of a :class:`SynthesisResult` and the system it was designed for."""
-    if not isinstance(result, SynthesisResult):
-        raise InputError(f"result must be a hinfnav SynthesisResult; got {type(result).__name__}")
-    if not isinstance(system, UncertainSystem):
-        raise InputError(f"system must be the UncertainSystem the filter was designed for; got {type(system).__name__}")
+    """JSON-ready dict of a certified design (:class:`SynthesisResult` or :class:`PolytopicResult`) and its system."""
+    polytopic = isinstance(result, PolytopicResult)
+    if not (polytopic or isinstance(result, SynthesisResult)):
+        raise InputError(f"result must be a hinfnav SynthesisResult or PolytopicResult; got {type(result).__name__}")
+    want = PolytopicSystem if polytopic else UncertainSystem
+    if not isinstance(system, want):
+        raise InputError(f"system must be the {want.__name__} the filter was designed for; got {type(system).__name__}")
     dt = 1.0 if result.dt is True else float(result.dt)
-    return {
+    cert = {
+        "gamma": result.gamma,
+        "lmi_gamma": result.lmi_gamma,
+        "verified_norm": result.verified_norm,
+        "spectral_radius": result.spectral_radius,
+        "sample_norms": np.asarray(result.sample_norms).tolist(),
+        "worst_sample": int(result.worst_sample),
+        "solver": result.solver,
+        "form": result.form,
+        "solve_time_s": result.solve_time_s,
+        "total_time_s": result.total_time_s,
+    }
+    if polytopic:
+        cert.update(lyapunov=result.lyapunov, covers=result.covers, alphas=np.asarray(result.alphas).tolist(),
+                    method="minimize", objective=result.objective)
+        sysd = {"kind": "polytope", "dt": dt, "labels": list(system.labels),
+                "vertices": [{k: getattr(v, k).tolist() for k in MATRIX_KEYS} for v in system.vertices]}
+        witness = {k: _plain(v) for k, v in result.witness.items()}
+    else:
+        cert.update(
+            method=result.method, structure=result.structure,
+            delta_bar=None if result.delta_bar is None else float(result.delta_bar),
+            deltas=None if result.deltas is None else np.asarray(result.deltas).tolist(),
+            covers="every time-varying F(k) with FᵀF ≤ I (one quadratic Lyapunov function)"
+            if system.H is not None else "the nominal system",
+        )
+        sysd = dict(_system_dict(system, dt), kind="norm-bounded")
+        witness = {k: _plain(v) for k, v in result.variables.items()}
+    out = {
         "format": FORMAT,
         "filter": {"A_F": result.A_F.tolist(), "B_F": result.B_F.tolist(), "C_F": result.C_F.tolist(), "dt": dt},
-        "certificate": {
-            "gamma": result.gamma,
-            "lmi_gamma": result.lmi_gamma,
-            "verified_norm": result.verified_norm,
-            "spectral_radius": result.spectral_radius,
-            "sample_norms": np.asarray(result.sample_norms).tolist(),
-            "worst_sample": int(result.worst_sample),
-            "solver": result.solver,
-            "method": result.method,
-            "structure": result.structure,
-            "form": result.form,
-            "delta_bar": None if result.delta_bar is None else float(result.delta_bar),
-            "deltas": None if result.deltas is None else np.asarray(result.deltas).tolist(),
-            "solve_time_s": result.solve_time_s,
-            "total_time_s": result.total_time_s,
-        },
-        "system": _system_dict(system, dt),
-        "fingerprint": system_fingerprint(system, dt),
+        "certificate": cert,
+        "system": sysd,
+        "witness": witness,
         "options": dict(options or {}),
         "extra": dict(extra or {}),
         "provenance": provenance(),
     }
+    out["fingerprint"] = content_fingerprint(out)
+    out["system_fingerprint"] = None if polytopic else system_fingerprint(system, dt)
+    return out
 
 
 def _matrix(d, key, path):
@@ -93,15 +134,23 @@ def _matrix(d, key, path):
 
 
 def design_from_dict(d, path="<dict>"):
-    """Rebuild ``(SynthesisResult, UncertainSystem, dict)`` from :func:`design_to_dict`'s output."""
+    """Rebuild ``(result, system, dict)`` from :func:`design_to_dict`'s output; refuse an edited file."""
+    if isinstance(d, dict) and d.get("format") == "hinfnav-design/1":
+        raise InputError(f"{path} is a design file of format hinfnav-design/1, whose fingerprint did not cover the "
+                         "filter and certificate (it cannot be trusted); design again and save with this version")
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise InputError(f"{path} is not a hinfnav design file (format {FORMAT!r} expected)")
     f, c, s = d.get("filter", {}), d.get("certificate", {}), d.get("system", {})
     if not all(isinstance(x, dict) for x in (f, c, s)):
         raise InputError(f"design file {path}: 'filter', 'certificate' and 'system' must be JSON objects")
+    if content_fingerprint(d) != d.get("fingerprint"):
+        raise InputError(f"design file {path}: its filter, certificate, system or witness does not match its "
+                         "fingerprint (the file was edited); refused")
     A_F, B_F, C_F = (_matrix(f, k, path) for k in ("A_F", "B_F", "C_F"))
-    mats = {k: (None if s.get(k) is None else _matrix(s, k, path)) for k in _MATRICES}
     try:
+        if s.get("kind") == "polytope":
+            return _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path)
+        mats = {k: (None if s.get(k) is None else _matrix(s, k, path)) for k in _MATRICES}
         return _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path)
     except (KeyError, TypeError, ValueError) as exc:
         if isinstance(exc, InputError):
@@ -109,8 +158,29 @@ def design_from_dict(d, path="<dict>"):
         raise InputError(f"design file {path}: missing or malformed entry ({type(exc).__name__}: {exc})") from None
 
 
+def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
+    verts = [UncertainSystem(*(_matrix(v, k, path) for k in MATRIX_KEYS), dt=float(s["dt"])) for v in s["vertices"]]
+    system = PolytopicSystem(tuple(verts), float(s["dt"]), tuple(s.get("labels", ())))
+    w = d.get("witness") or {}
+    result = PolytopicResult(
+        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),
+        verified_norm=float(c["verified_norm"]), sample_norms=np.asarray(c.get("sample_norms", []), dtype=float),
+        alphas=np.asarray(c.get("alphas", []), dtype=float), worst_sample=int(c.get("worst_sample", 0)),
+        spectral_radius=float(c["spectral_radius"]), lyapunov=str(c["lyapunov"]), form=str(c["form"]),
+        covers=str(c["covers"]), objective=str(c.get("objective", "hinf")),
+        witness=dict({k: np.asarray(v, dtype=float) for k, v in w.items() if k != "P"},
+                     P=[np.asarray(P, dtype=float) for P in w.get("P", [])]),
+        solver=str(c.get("solver")), solve_time_s=float(c.get("solve_time_s", 0.0)),
+        total_time_s=float(c.get("total_time_s", 0.0)), dt=float(f["dt"]),
+    )
+    return result, system, d
+
+
 def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
     system = UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], mats["H"], mats["E"], float(s["dt"]))
+    w = d.get("witness") or {}
+    variables = {k: (np.asarray(v, dtype=float) if isinstance(v, list) and k != "P" else
+                     [np.asarray(P, dtype=float) for P in v] if k == "P" else v) for k, v in w.items()}
     result = SynthesisResult(
         A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),
         verified_norm=float(c["verified_norm"]), sample_norms=np.asarray(c.get("sample_norms", []), dtype=float),
@@ -119,9 +189,8 @@ def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
         total_time_s=float(c.get("total_time_s", 0.0)), method=str(c.get("method")), dt=float(f["dt"]),
         structure=str(c.get("structure")), delta_bar=c.get("delta_bar"),
         deltas=None if c.get("deltas") is None else np.asarray(c["deltas"], dtype=float), form=str(c.get("form")),
+        variables=variables, system=system,
     )
-    if system_fingerprint(system, float(s["dt"])) != d.get("fingerprint"):
-        raise InputError(f"design file {path}: its system does not match its fingerprint (the file was edited)")
     return result, system, d
 
 
@@ -135,7 +204,7 @@ def save_design(result, system, path, *, options=None, extra=None):
     path = check_design_path(path)
     text = json.dumps(design_to_dict(result, system, options=options, extra=extra), indent=2) + "\n"
     tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
+    tmp.write_text(text, encoding="utf-8")
     tmp.replace(path)
     return path
 
@@ -146,7 +215,7 @@ def load_design(path):
     if not path.is_file():
         raise InputError(f"design file {path} does not exist (or is not a file)")
     try:
-        d = json.loads(path.read_text())
+        d = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"design file {path} is not valid JSON ({exc})") from None
     return design_from_dict(d, path)

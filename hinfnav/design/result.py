@@ -72,6 +72,9 @@ class SynthesisResult:
     form : str
         ``"general"`` (LMI (20) as in the paper) or ``"observer"`` (filter
         constrained to ``C_F = −L``, ``A_F = A + B_F C``; see :func:`synthesize`).
+    system : UncertainSystem or None
+        The system the filter was designed for (with its sampling time), so
+        that a design can be saved with its own system.
     """
 
     A_F: np.ndarray
@@ -96,6 +99,7 @@ class SynthesisResult:
     deltas: np.ndarray = None
     form: str = "general"
     sample_labels: tuple = ()
+    system: object = None
 
     def statespace(self):
         """The filter as a discrete :class:`control.StateSpace` (y → z_f), with ``dt``."""

@@ -63,11 +63,14 @@ from ..core.exceptions import (
     LooseBoundWarning,
     SolverAccuracyWarning,
 )
+from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least, as_positive, as_seed
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..lmi.conditioning import lmi20_diagonal, normalize, prepare
 from ..lmi.solve import INFEASIBLE, SolverOptions, solve_lmi
 from ..systems.uncertain import UncertainSystem
+from .explain import infeasibility_hint
+from .polytopic import observer_nominal
 from .result import SynthesisResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 from .tighten import best_candidate as _best, brl_solvers as _brl_solvers, full_lyapunov_gamma, is_loose, key as _key
@@ -360,8 +363,13 @@ def synthesize(
                 f"form='observer' needs L square and invertible (C_F = −L); L is singular (cond {condL:.3g})"
             )
     solvers = list(options.solvers)
+    if not np.any(system.L):
+        raise InputError("L is zero: the estimated signal z = L x is identically 0, so there is nothing to estimate "
+                         "(the zero filter is exact); give a nonzero L")
     if system.H is not None and not (np.any(system.H) and np.any(system.E)):
         system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, None, None, 1.0)
+    if form == "observer" and system.H is None and not spectral_radius(system.A) < 1.0:
+        return observer_nominal(system, dt_value, solvers, t_start)  # needs detectability only (no plant state)
     sample_set = uncertainty_samples if isinstance(uncertainty_samples, SampleSet) else None
     if uncertainty_samples is None:
         samples = default_uncertainty_samples(system, structure, n_random_samples, seed)
@@ -434,19 +442,10 @@ def synthesize(
             deltas=None if sample_set is None else sample_set.values,
             form=form,
             sample_labels=() if sample_set is None else sample_set.labels,
+            system=dataclasses.replace(system, dt=1.0 if dt_value is True else dt_value),
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
-        hint = (
-            " With structure='full' F may be any contraction; if F is diagonal (as in the paper), "
-            "structure='diagonal' balances H and E channel by channel and is less conservative."
-            if structure == "full" and system.H is not None and min(system.H.shape[1], system.E.shape[0]) > 1
-            else ""
-        )
-        if form == "observer":
-            hint += (
-                " The observer-form constraints (C_F = −L, A_F = A + B_F C) were imposed; "
-                "form='general' may be feasible."
-            )
+        hint = infeasibility_hint(system.A, system.H, system.E, structure, form)
         raise InfeasibleLMIError(
             "LMI (20) is infeasible: no R, S, λ make the error system quadratically stable for every admissible F, "
             "so Theorem 1 gives no filter for any γ; confirmed on the γ-free part of (20), which contains neither "

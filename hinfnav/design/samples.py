@@ -12,6 +12,7 @@ import numpy as np
 from ..core.exceptions import InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
+from .explain import unstable_plant_message
 
 __all__ = ["SampleSet", "default_uncertainty_samples", "check_samples", "check_plant"]
 
@@ -125,27 +126,17 @@ def check_samples(samples, system, structure):
     return checked
 
 
-_UNSTABLE_MSG = (
-    "the plant is not robustly Schur stable: A + H F E has spectral radius {rho:.12g} >= 1 at {where}. "
-    "Lemma 1 bounds the error system (13), whose state contains the plant state x "
-    "(Ā = [[A + ΔA, 0], [B_F C, A_F]] is block triangular, so its eigenvalues include those of A + ΔA); "
-    "no filter can make it stable and no finite γ exists. The unforced Hill model (the no-maneuver case, "
-    "A = I + T·A₁, spectral radius >= 1) is such a plant: design on the closed loop u = Kx, "
-    "A = I + T(A₁ + G₀K), instead (Scenario.design_model)."
-)
-
-
 def check_plant(system, samples, labels=None):
     """Raise UnstablePlantError unless A and every A + H F E sampled are Schur stable (internal)."""
     rho = spectral_radius(system.A)
     if not rho < 1.0:
-        raise UnstablePlantError(_UNSTABLE_MSG.format(rho=rho, where="the nominal plant (F = 0)"))
+        raise UnstablePlantError(unstable_plant_message(rho, "the nominal plant (F = 0)"))
     for i, F in enumerate(samples):
         if F is None:
             continue
         rho = spectral_radius(system.perturbed_A(F))
         if not rho < 1.0:
             what = "" if labels is None else f" ({labels[i]})"
-            raise UnstablePlantError(_UNSTABLE_MSG.format(rho=rho, where=f"uncertainty sample {i}{what}"))
+            raise UnstablePlantError(unstable_plant_message(rho, f"uncertainty sample {i}{what}"))
 
 

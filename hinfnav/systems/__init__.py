@@ -27,7 +27,9 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .files import read_system_file
 from .planar import ConvertedRangeBearing, RangeBearing
+from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 
@@ -59,4 +61,8 @@ __all__ = [
     "measurement_matrix",
     "position_measurement",
     "UncertainSystem",
+    "PolytopicSystem",
+    "simplex_grid",
+    "two_mass_spring",
+    "read_system_file",
 ]

@@ -416,6 +416,15 @@ def _scenario(scenario):
     return scenario
 
 
+def _is_scenario_design(result):
+    """Whether a result was made by :func:`design_for_scenario` (its system is the paper's design model)."""
+    own = result.system
+    if getattr(result, "delta_bar", None) is None or not hasattr(own, "A"):
+        return False
+    ref = Scenario().design_model(float(result.delta_bar))
+    return own.A.shape == ref.A.shape and np.allclose(own.A, ref.A) and np.allclose(own.B, ref.B)
+
+
 def save_design(result, path, scenario=None):
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
 
@@ -423,6 +432,10 @@ def save_design(result, path, scenario=None):
     the scenario at the design's δ̄ (with its fingerprint and T), the design
     options and provenance (:mod:`hinfnav.design.io`). Returns the path.
     """
+    own = getattr(result, "system", None)
+    if scenario is None and own is not None and not _is_scenario_design(result):
+        # a design of another system (not from design_for_scenario): saved with its own system
+        return design_io.save_design(result, own, path, options={"form": result.form})
     if not isinstance(result, SynthesisResult):
         raise InputError(f"result must be a hinfnav SynthesisResult (from design_for_scenario); got {type(result).__name__}")
     scenario = _scenario(scenario)
@@ -443,8 +456,13 @@ def load_design(path, scenario=None):
         If the file is not a design, was edited, or was designed for another
         system (another T, B, D, K, …): the message names what differs.
     """
+    result, system, d = design_io.load_design(path)
+    if scenario is None and (d.get("extra") or {}).get("paper") != "sun2011":
+        return result  # a design of another system: checked against its own fingerprint only
     scenario = _scenario(scenario)
-    result, system, _ = design_io.load_design(path)
+    if not isinstance(result, SynthesisResult):
+        raise InputError(f"design file {path} was made for another system (a polytope of "
+                         f"{getattr(system, 'n_vertices', '?')} vertices), not for the scenario: design again for it")
     delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
     design_io.check_design_system(system, system.dt, scenario.design_model(delta_bar), scenario.dt,
                                   what="the scenario")

@@ -1,0 +1,87 @@
+"""Design a certified filter for a system read from a TOML file (``design --system``).
+
+Nominal and norm-bounded systems with ``lyapunov="common"`` go to
+:func:`~hinfnav.design.synthesize` (Corollary 1: arbitrarily time-varying F);
+a norm-bounded system with ``lyapunov="parameter-dependent"`` is first
+written as the polytope of its sign vertices
+(:meth:`~hinfnav.systems.PolytopicSystem.from_norm_bounded`, F diagonal), and
+polytopes go to :func:`~hinfnav.design.synthesize_polytopic`.
+"""
+
+import numpy as np
+
+from ..core.provenance import provenance
+from ..core.validation import as_choice
+from ..systems.files import read_system_file
+from ..systems.polytopic import PolytopicSystem
+from .polytopic import COVERS, LYAPUNOV, PolytopicResult, synthesize_polytopic
+from .robust_hinf import synthesize
+
+__all__ = ["design_from_system_file", "design_summary"]
+
+
+def design_summary(result):
+    """JSON-ready summary of a certified design (either result type)."""
+    poly = isinstance(result, PolytopicResult)
+    system = result.system
+    if poly:
+        lyapunov, covers = result.lyapunov, result.covers
+    else:
+        lyapunov = "common"
+        covers = (COVERS["common"].replace("α(k) in the simplex", "F(k) with FᵀF ≤ I")
+                  if system is not None and system.H is not None else "the nominal system")
+    return {
+        "gamma": float(result.gamma),
+        "lmi_gamma": float(result.lmi_gamma),
+        "verified_worst_norm": float(result.verified_norm),
+        "n_samples": int(np.size(result.sample_norms)),
+        "objective": getattr(result, "objective", "hinf"),
+        "lyapunov": lyapunov,
+        "form": result.form,
+        "covers": covers,
+        "solver": result.solver,
+        "A_F": result.A_F.tolist(),
+        "B_F": result.B_F.tolist(),
+        "C_F": result.C_F.tolist(),
+        "provenance": provenance(),
+    }
+
+
+def design_from_system_file(path, *, lyapunov=None, form="general", objective="hinf", solver=None):
+    """Read ``path`` (:func:`~hinfnav.systems.read_system_file`) and design a certified H∞ filter.
+
+    Parameters
+    ----------
+    lyapunov : {"common", "parameter-dependent"}, optional
+        Default: parameter-dependent for a polytope, common otherwise.
+    form : {"general", "observer"}
+    objective : {"hinf", "h2"}
+        ``"h2"``: the extended H2 LMIs (E2) on the polytope (a norm-bounded
+        system as its sign-vertex polytope, F diagonal; a nominal one as one
+        vertex); the summary's ``gamma`` is then the certified H2 bound.
+    solver : str, optional
+
+    Returns
+    -------
+    (SynthesisResult or PolytopicResult, dict)
+        The result (with its ``system``) and :func:`design_summary`.
+    """
+    objective = as_choice("objective", objective, ("hinf", "h2"))
+    if lyapunov is not None:
+        lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
+    form = as_choice("form", form, ("general", "observer"))
+    system = read_system_file(path)
+    if objective == "h2":  # H2: the extended LMIs (E2) on the polytope (one vertex when nominal)
+        if not isinstance(system, PolytopicSystem):
+            system = PolytopicSystem.from_norm_bounded(system)
+        lyapunov = lyapunov or ("parameter-dependent" if system.n_vertices > 1 else "common")
+        result = synthesize_polytopic(system, lyapunov=lyapunov, form=form, solver=solver, objective="h2")
+    elif isinstance(system, PolytopicSystem):
+        result = synthesize_polytopic(system, lyapunov=lyapunov or "parameter-dependent", form=form, solver=solver)
+    elif system.H is not None and lyapunov == "parameter-dependent":
+        result = synthesize_polytopic(PolytopicSystem.from_norm_bounded(system), lyapunov=lyapunov, form=form,
+                                      solver=solver)
+    else:
+        result = synthesize(system.A, system.B, system.C, system.D, system.L, system.H, system.E, dt=system.dt,
+                            form=form, solver=solver, structure="full")
+    return result, design_summary(result)

@@ -1,0 +1,390 @@
+"""Certified robust H∞ filters on polytopes: common or parameter-dependent Lyapunov matrices.
+
+:func:`synthesize_polytopic` minimizes γ² subject to the extended bounded real
+LMI (E1) of :mod:`hinfnav.lmi.polytopic` at every vertex of a
+:class:`~hinfnav.systems.PolytopicSystem`, and certifies the returned filter
+independently of the solver's status:
+
+1. (E1) is re-evaluated in float64 at the returned filter (``G Ā`` and
+   ``G B̄`` recomputed from the filter matrices, not taken from the solver)
+   and the solver's ``Pᵢ`` and ``G``; the smallest γ making it positive
+   definite at every vertex is found by a Schur complement confirmed by an
+   eigenvalue test (:func:`hinfnav.analysis.certificates.schur_gamma`). This
+   is the result's ``gamma``; :func:`certify_polytopic` does it from a saved
+   witness alone (no solver).
+2. The H∞ norm of the error system is computed (SLICOT ab13dd) on a dense
+   grid of the simplex plus its vertices (:func:`simplex_grid`); every
+   sample must be Schur stable with a norm ≤ ``gamma``.
+
+What the certificate covers is stated in ``covers``: with one common
+Lyapunov matrix, every arbitrarily time-varying α(k) in the simplex
+(quadratic stability); with parameter-dependent ones, every α constant in
+time (a Lyapunov function ``ξᵀ(Σ αᵢ Pᵢ)ξ`` for each α).
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+
+from ..analysis.certificates import certify_negative_definite, schur_gamma
+from ..analysis.error_system import worst_case_norm
+from ..analysis.norms import h2_norm, hinf_norm
+from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError, UnstablePlantError
+from ..core.linalg import spectral_radius
+from ..core.validation import as_choice, as_int_at_least
+from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
+from ..lmi.solve import INFEASIBLE, SOLVERS
+from ..systems.polytopic import PolytopicSystem, simplex_grid
+from ..systems.uncertain import UncertainSystem
+from .explain import small_gain_number, unstable_plant_message
+from .result import SynthesisResult
+
+__all__ = ["LYAPUNOV", "COVERS", "PolytopicResult", "synthesize_polytopic", "certify_polytopic",
+           "sampled_norms", "error_coordinates", "observer_nominal"]
+
+#: Lyapunov structures :func:`synthesize_polytopic` accepts.
+LYAPUNOV = ("common", "parameter-dependent")
+
+#: What each certificate covers.
+COVERS = {
+    "common": "every arbitrarily time-varying α(k) in the simplex (one quadratic Lyapunov function)",
+    "parameter-dependent": "every α constant in time in the simplex (uncertainty constant in time; "
+                           "Lyapunov matrix Σ αᵢ Pᵢ)",
+}
+
+
+@dataclass(frozen=True, eq=False)
+class PolytopicResult:
+    """A certified H∞ filter for a polytopic system.
+
+    Attributes
+    ----------
+    A_F, B_F, C_F : ndarray
+        The filter ``x_f⁺ = A_F x_f + B_F y``, ``z_f = C_F x_f``.
+    gamma : float
+        Certified level: (E1) positive definite in float64 at every vertex at
+        the returned filter and witness.
+    lmi_gamma : float
+        The solver's γ.
+    verified_norm : float
+        Largest sampled H∞ norm of the error system (a lower bound of the worst case).
+    sample_norms : ndarray, shape (K,)
+    alphas : ndarray, shape (K, N)
+        The convex weights sampled (vertices, lattice, random points).
+    worst_sample : int
+    spectral_radius : float
+        Largest spectral radius of the (error-coordinate) error system over the samples.
+    lyapunov, form, covers : str
+    witness : dict
+        ``P`` (list of arrays, one per vertex) and ``G``: the LMI variables
+        that :func:`certify_polytopic` re-checks.
+    solver : str
+    solve_time_s, total_time_s : float
+    dt : float
+    attempts : tuple of str
+    system : PolytopicSystem or None
+        The polytope the filter was designed for.
+    objective : {"hinf", "h2"}
+        With ``"h2"``, ``gamma``, ``lmi_gamma``, ``verified_norm`` and
+        ``sample_norms`` are H2 norms (bound and sampled), ``witness`` has W.
+    """
+
+    A_F: np.ndarray
+    B_F: np.ndarray
+    C_F: np.ndarray
+    gamma: float
+    lmi_gamma: float
+    verified_norm: float
+    sample_norms: np.ndarray
+    alphas: np.ndarray
+    worst_sample: int
+    spectral_radius: float
+    lyapunov: str
+    form: str
+    covers: str
+    witness: dict = field(default_factory=dict)
+    solver: str = ""
+    solve_time_s: float = 0.0
+    total_time_s: float = 0.0
+    dt: float = 1.0
+    attempts: tuple = ()
+    system: object = None
+    objective: str = "hinf"
+
+    def statespace(self):
+        """The filter as a discrete :class:`control.StateSpace` (y → z_f)."""
+        return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
+
+
+def _vertex_tuples(system):
+    return [(v.A, v.B, v.C, v.D, v.L) for v in system.vertices]
+
+
+def error_coordinates(vertex, A_F, B_F, C_F, form):
+    """``(Ā, B̄, C̄)`` of the error system at one vertex ``(A, B, C, D, L)``.
+
+    General form: ``ξ = [x; x_f]`` (13)–(14). Observer form: the error
+    ``e = x + x_f`` alone, ``(A_F, [B, B_F D], L)`` (exact when A, C, L are
+    the vertex's nominal ones; its transfer function equals the general one).
+    """
+    A, B, C, D, L = vertex
+    n, p = B.shape
+    q = D.shape[1]
+    if form == "observer":
+        return A_F, np.hstack([B, B_F @ D]), L
+    nf = A_F.shape[0]
+    Abar = np.block([[A, np.zeros((n, nf))], [B_F @ C, A_F]])
+    Bbar = np.block([[B, np.zeros((n, q))], [np.zeros((nf, p)), B_F @ D]])
+    return Abar, Bbar, np.hstack([L, -C_F])
+
+
+def certify_polytopic(system, A_F, B_F, C_F, witness, form="general"):
+    """Smallest γ for which (E1) holds in float64 at every vertex with the witness ``P``, ``G`` (no solver).
+
+    Returns
+    -------
+    gamma : float
+        The largest over the vertices (``inf`` if (E1) fails at some vertex
+        for every γ).
+    per_vertex : list of float
+    """
+    if "W" in witness:
+        return _certify_h2(system, A_F, B_F, C_F, witness, form)
+    P_list, G = witness["P"], np.asarray(witness["G"], dtype=float)
+    if len(P_list) != system.n_vertices:
+        raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
+    per = []
+    for vert, P in zip(_vertex_tuples(system), P_list):
+        Abar, Bbar, Cbar = error_coordinates(vert, A_F, B_F, C_F, form)
+        P = np.asarray(P, dtype=float)
+        if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape:
+            raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the error system "
+                             f"has {Abar.shape[0]} states")
+        N0 = extended_hinf_matrix(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
+        g, _ = schur_gamma(-N0, hinf_gamma_index(Abar.shape[0], Bbar.shape[1]))
+        per.append(g)
+    return max(per), per
+
+
+def _certify_h2(system, A_F, B_F, C_F, witness, form):
+    """Certified H2 bound from (E2) in float64: both matrices positive definite at every vertex (internal)."""
+    P_list, G, W = witness["P"], np.asarray(witness["G"], dtype=float), np.asarray(witness["W"], dtype=float)
+    if len(P_list) != system.n_vertices:
+        raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
+    scale = max(abs(np.trace(W)), np.finfo(float).tiny)
+    for eps in (0.0, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4):
+        Wc = W + eps * scale * np.eye(W.shape[0])
+        ok = True
+        for vert, P in zip(_vertex_tuples(system), P_list):
+            Abar, Bbar, Cbar = error_coordinates(vert, A_F, B_F, C_F, form)
+            P = np.asarray(P, dtype=float)
+            if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape or Wc.shape != (Bbar.shape[1],) * 2:
+                raise InputError("the witness's P, G or W does not fit the error system's dimensions")
+            M1, M2 = extended_h2_matrices(P, G @ Abar, G @ Bbar, Cbar, G, Wc)
+            if not (certify_negative_definite(-M1)[0] and certify_negative_definite(-M2)[0]):
+                ok = False
+                break
+        if ok:
+            g = float(np.sqrt(max(np.trace(Wc), 0.0)))
+            return g, [g] * system.n_vertices
+    return float("inf"), [float("inf")] * system.n_vertices
+
+
+def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None, objective="hinf"):
+    """H∞ norms of the error system at convex weights ``alphas`` (default: :func:`simplex_grid`).
+
+    Returns ``(norms, spectral_radii, alphas)``.
+    """
+    if alphas is None:
+        alphas = simplex_grid(system.n_vertices, points=41 if system.n_vertices <= 2 else 200,
+                              n_random=0 if system.n_vertices <= 2 else 20)
+    norms, radii = [], []
+    for a in alphas:
+        s = system.at(a)
+        if objective == "h2":
+            Ab, Bb, Cb = error_coordinates((s.A, s.B, s.C, s.D, s.L), A_F, B_F, C_F, form)
+            radii.append(spectral_radius(Ab))
+            norms.append(h2_norm(control.ss(Ab, Bb, Cb, np.zeros((Cb.shape[0], Bb.shape[1])), True)))
+        elif form == "observer":
+            Ab, Bb, Cb = error_coordinates((s.A, s.B, s.C, s.D, s.L), A_F, B_F, C_F, form)
+            radii.append(spectral_radius(Ab))
+            norms.append(hinf_norm(control.ss(Ab, Bb, Cb, np.zeros((Cb.shape[0], Bb.shape[1])), True)))
+        else:
+            wc = worst_case_norm(s, A_F, B_F, C_F, dt=1.0)
+            radii.append(float(wc.spectral_radii[0]))
+            norms.append(wc.norm)
+    return np.array(norms), np.array(radii), np.asarray(alphas)
+
+
+def _check(system, form):
+    if form == "observer":
+        varying = [k for k in system.varying() if k in ("A", "C", "L")]
+        if varying:
+            raise InputError(
+                f"form='observer' needs the uncertainty not to multiply the plant state, but {', '.join(varying)} "
+                "differ between the vertices: the estimation error then contains ΔA x (or ΔC x, ΔL x), driven by the "
+                "plant trajectory, so the error system carries the plant state. Use form='general' (needs the plant "
+                "Schur stable at every vertex), or keep A, C and L common to all vertices.")
+        return
+    for i, v in enumerate(system.vertices):
+        rho = spectral_radius(v.A)
+        if not rho < 1.0:
+            raise UnstablePlantError(unstable_plant_message(rho, f"vertex {i} ({system.labels[i]})"))
+
+
+def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="general", solver=None, grid_points=None,
+                         seed=0, objective="hinf"):
+    """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
+
+    Parameters
+    ----------
+    system : PolytopicSystem
+        The vertices (a single vertex: the nominal H∞ filter).
+    lyapunov : {"parameter-dependent", "common"}, optional
+        One Lyapunov matrix per vertex (certifies α constant in time), or one
+        for all (certifies arbitrarily time-varying α(k)).
+    form : {"general", "observer"}, optional
+        Any full-order filter (needs the plant Schur stable at each vertex),
+        or a predictor observer ``C_F = −L``, ``A_F = A + B_F C`` (needs only
+        detectability; A, C, L must be common to all vertices).
+    solver : str, optional
+        cvxpy solver; default Clarabel, then CVXOPT if Clarabel's answer
+        does not certify.
+    grid_points : int, optional
+        Lattice points of the simplex for the sampled norms (default 41 for
+        two vertices, 200 plus 20 random points otherwise).
+    seed : int, optional
+        Seed of the random simplex points.
+    objective : {"hinf", "h2"}, optional
+        ``"h2"``: minimize the H2 bound ``tr W`` of the extended H2 LMIs (E2)
+        instead (same filter parametrization; the result's norms are H2).
+
+    Returns
+    -------
+    PolytopicResult
+
+    Raises
+    ------
+    InputError, UnstablePlantError, InfeasibleLMIError, CertificationError
+    """
+    t0 = time.perf_counter()
+    if not isinstance(system, PolytopicSystem):
+        raise InputError(f"system must be a hinfnav PolytopicSystem; got {type(system).__name__}")
+    lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
+    form = as_choice("form", form, ("general", "observer"))
+    objective = as_choice("objective", objective, ("hinf", "h2"))
+    solvers = ("CLARABEL", "CVXOPT") if solver is None else (as_choice("solver", str(solver).upper(), SOLVERS),)
+    if not np.any([np.any(v.L) for v in system.vertices]):
+        raise InputError("L is zero at every vertex: the estimated signal z = L x is identically 0, so there is "
+                         "nothing to estimate (the zero filter is exact); give a nonzero L")
+    _check(system, form)
+    N = system.n_vertices
+    if grid_points is None:
+        alphas = simplex_grid(N, points=41 if N <= 2 else 200, n_random=0 if N <= 2 else 20, seed=seed)
+    else:
+        alphas = simplex_grid(N, points=as_int_at_least("grid_points", grid_points, 1), n_random=0, seed=seed)
+    verts = _vertex_tuples(system)
+    log, statuses, best, seconds = [], [], None, 0.0
+    for slv in solvers:
+        sol = solve_polytopic_hinf(verts, form, lyapunov, slv, objective=objective)
+        seconds += sol["seconds"]
+        statuses.append(f"{slv} {sol['status']}")
+        if "P" not in sol:
+            log.append(f"{slv}: status {sol['status']}, no solution")
+            continue
+        tries = [sol]
+        g_s = float(np.sqrt(max(sol["gamma2"], 0.0)))
+        cand = _rebuild_and_certify(system, sol, form, alphas, objective)
+        log.append(f"{slv} minimize: status {sol['status']}, solver γ = {g_s:.10g}, certified γ = {cand[0]:.10g}")
+        if not cand[-1] or cand[0] > g_s * (1 + 1e-3):
+            for step in (1e-5, 1e-4, 1e-3, 1e-2, 1e-1):  # an interior point just above the solver's level certifies better
+                sol2 = solve_polytopic_hinf(verts, form, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2,
+                                            objective=objective)
+                seconds += sol2["seconds"]
+                if "P" in sol2 and sol2["margin"] > 0:
+                    c2 = _rebuild_and_certify(system, sol2, form, alphas, objective)
+                    log.append(f"{slv} feasibility at γ = {g_s * (1 + step):.10g}: certified γ = {c2[0]:.10g}")
+                    if c2[-1] and (not cand[-1] or c2[0] < cand[0]):
+                        cand, tries = c2, [sol2]
+                        break
+        if cand[-1] and (best is None or cand[0] < best[0][0]):
+            best = (cand, tries[0], slv, g_s)
+        if best is not None and best[0][0] <= best[3] * (1 + 1e-5):
+            break  # certified at the solver's own level: the other solvers would not do better
+    if best is None:
+        if all(any(s.endswith(st) for st in INFEASIBLE) or "solver error" in s for s in statuses):
+            hint = (" With one common Lyapunov matrix the filter must work for arbitrarily time-varying α(k); "
+                    "lyapunov='parameter-dependent' only asks for α constant in time and is less conservative."
+                    if lyapunov == "common" and N > 1 else
+                    " Reduce the uncertainty (a smaller polytope) or check that the plant is detectable from y.")
+            if N == 2 and set(system.varying()) <= {"A"}:
+                nb = system.norm_bounded_cover()
+                hint += (f" The small-gain number of the polytope written as A₀ + H F E (‖E(zI − A₀)⁻¹H‖∞, H of rank "
+                         f"{nb.H.shape[1]}) is {small_gain_number(nb.A, nb.H, nb.E):.4g}: at or above 1 no single "
+                         "quadratic Lyapunov function exists for time-varying F.")
+            raise InfeasibleLMIError("no solver found a solution of the extended LMIs ((E1) for H∞, (E2) for H2) at the vertices: "
+                                     "infeasible, or too ill-conditioned to solve (solver status: "
+                                     + "; ".join(statuses) + ")." + hint)
+        raise CertificationError("no solution of the extended LMIs passed certification: " + " | ".join(log))
+    (gamma_c, A_F, B_F, C_F, witness, norms, radii, ok), sol, slv, g_s = best
+    k = int(np.argmax(norms))
+    return PolytopicResult(
+        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(gamma_c), lmi_gamma=g_s, verified_norm=float(norms[k]),
+        sample_norms=norms, alphas=alphas, worst_sample=k, spectral_radius=float(np.max(radii)),
+        lyapunov=lyapunov, form=form, covers=COVERS[lyapunov], witness=witness, solver=slv,
+        solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
+        system=system, objective=objective,
+    )
+
+
+def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):
+    """Filter from the solver's variables, (E1) in float64, sampled norms; a tuple ending in ok (internal)."""
+    fail = (float("inf"), None, None, None, None, None, None, False)
+    if form == "observer":
+        A, C, L = system.vertices[0].A, system.vertices[0].C, system.vertices[0].L
+        G = sol["G"]
+        if not np.linalg.cond(G) < 1e14:
+            return fail
+        B_F = np.linalg.solve(G, sol["Ghat"])
+        A_F, C_F = A + B_F @ C, -L.copy()
+    else:
+        V = sol["V"]
+        if not np.linalg.cond(V) < 1e14:
+            return fail
+        A_F, B_F, C_F = np.linalg.solve(V, sol["Ahat"]), np.linalg.solve(V, sol["Bhat"]), sol["C_F"].copy()
+    witness = {"P": [np.array(P) for P in sol["P"]], "G": np.array(sol["G"])}
+    if objective == "h2":
+        witness["W"] = 0.5 * (sol["W"] + sol["W"].T)
+    gamma_c, _ = certify_polytopic(system, A_F, B_F, C_F, witness, form)
+    if not np.isfinite(gamma_c):
+        return fail
+    norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, alphas, objective)
+    ok = bool(np.all(radii < 1.0) and np.max(norms) <= gamma_c * (1 + 1e-9))
+    return gamma_c, A_F, B_F, C_F, witness, norms, radii, ok
+
+
+def observer_nominal(system, dt, solvers, t_start):
+    """Nominal observer-form filter of a plant that need not be stable, as a :class:`SynthesisResult`.
+
+    The estimation error ``e⁺ = (A + B_F C) e + B w + B_F D v`` does not
+    contain the plant state, so only (A, C) detectable is needed; designed by
+    :func:`synthesize_polytopic` on the single vertex (internal, used by
+    :func:`hinfnav.design.synthesize` with ``form="observer"`` and no
+    uncertainty). The certificate is (E1) in error coordinates and the norm of
+    the error-coordinate system; the witness is in ``variables``.
+    """
+    system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, dt=1.0 if dt is True else dt)
+    poly = PolytopicSystem((system,), system.dt)
+    res = synthesize_polytopic(poly, lyapunov="common", form="observer", solver=solvers[0] if len(solvers) == 1 else None)
+    return SynthesisResult(
+        A_F=res.A_F, B_F=res.B_F, C_F=res.C_F, gamma=res.gamma, lmi_gamma=res.lmi_gamma,
+        verified_norm=res.verified_norm, sample_norms=res.sample_norms, worst_sample=0,
+        spectral_radius=res.spectral_radius, solver=res.solver, solve_time_s=res.solve_time_s,
+        total_time_s=time.perf_counter() - t_start, method="minimize", dt=dt,
+        variables={"P": res.witness["P"], "G": res.witness["G"], "lyapunov": "common",
+                   "coordinates": "estimation error e = x + x_f (observer form)"},
+        attempts=res.attempts + ("nominal observer form in error coordinates: the plant need not be stable",),
+        samples=(None,), form="observer", system=system,
+    )

@@ -1,0 +1,111 @@
+"""A system of one's own from a TOML file: nominal, norm-bounded or polytopic.
+
+Format (nested lists of numbers; ``x⁺ = A x + B w``, ``y = C x + D v``,
+``z = L x``, w and v separate noise inputs as everywhere in hinfnav)::
+
+    dt = 0.1                       # sampling time, s
+    [nominal]
+    A = [[1.0, 0.1], [0.0, 1.0]]
+    B = [[0.005], [0.1]]
+    C = [[1.0, 0.0]]
+    D = [[0.1]]
+    L = [[1.0, 0.0], [0.0, 1.0]]
+    [uncertainty]                  # optional
+    kind = "norm-bounded"          # A + H F E, FᵀF ≤ I
+    H = [[0.0], [0.01]]
+    E = [[1.0, 0.0]]
+    # or: kind = "polytope" and [[uncertainty.vertices]] tables, each giving
+    # any of A, B, C, D, L that differ from [nominal]
+
+Every error names the key in the file.
+"""
+
+import tomllib
+
+from ..core.exceptions import InputError
+from ..core.validation import as_matrix, as_path, as_positive
+from .polytopic import MATRIX_KEYS, PolytopicSystem
+from .uncertain import UncertainSystem
+
+__all__ = ["read_system_file"]
+
+
+def _matrix(where, table, key, required=True):
+    if key not in table:
+        if required:
+            raise InputError(f"{where}: missing key {key!r} (a matrix as nested lists)")
+        return None
+    try:
+        return as_matrix(f"{where}.{key}", table[key])
+    except InputError as exc:
+        raise InputError(f"{where}.{key}: {exc}") from None
+
+
+def read_system_file(path):
+    """Read a system TOML file.
+
+    Returns
+    -------
+    UncertainSystem or PolytopicSystem
+        Nominal or norm-bounded (``UncertainSystem``), or a polytope.
+
+    Raises
+    ------
+    InputError
+        Missing file, not UTF-8, not TOML, a missing or malformed key (named).
+    """
+    path = as_path("path", path)
+    if not path.is_file():
+        raise InputError(f"system file {path} does not exist (or is not a file)")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"system file {path} is not UTF-8 text (byte {exc.start}); TOML files must be UTF-8 "
+                         "(re-save it as UTF-8)") from None
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"system file {path} is not valid TOML ({exc})") from None
+    where = str(path)
+    unknown = sorted(set(d) - {"dt", "nominal", "uncertainty"})
+    if unknown:
+        raise InputError(f"{where}: unknown top-level key(s) {unknown}; allowed: dt, [nominal], [uncertainty]")
+    if "dt" not in d:
+        raise InputError(f"{where}: missing key 'dt' (the sampling time, s)")
+    try:
+        dt = as_positive("dt", d["dt"])
+    except InputError as exc:
+        raise InputError(f"{where}: key 'dt': {exc}") from None
+    nom = d.get("nominal")
+    if not isinstance(nom, dict):
+        raise InputError(f"{where}: missing table [nominal] with A, B, C, D, L")
+    bad = sorted(set(nom) - set(MATRIX_KEYS))
+    if bad:
+        raise InputError(f"{where}: [nominal] has unknown key(s) {bad}; allowed: {', '.join(MATRIX_KEYS)}")
+    mats = {k: _matrix("[nominal]", nom, k) for k in MATRIX_KEYS}
+    unc = d.get("uncertainty")
+    try:
+        if unc is None:
+            return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=dt)
+        if not isinstance(unc, dict):
+            raise InputError("key 'uncertainty' must be a table [uncertainty]")
+        kind = unc.get("kind")
+        if kind == "norm-bounded":
+            H, E = _matrix("[uncertainty]", unc, "H"), _matrix("[uncertainty]", unc, "E")
+            return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], H, E, dt=dt)
+        if kind == "polytope":
+            verts = unc.get("vertices")
+            if not isinstance(verts, list) or not verts or not all(isinstance(v, dict) for v in verts):
+                raise InputError("[uncertainty] kind = 'polytope' needs 'vertices', an array of tables "
+                                 "([[uncertainty.vertices]]) each with any of A, B, C, D, L")
+            for i, v in enumerate(verts):
+                bad = sorted(set(v) - set(MATRIX_KEYS))
+                if bad:
+                    raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
+                                     f"{', '.join(MATRIX_KEYS)}")
+            verts = [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
+            return PolytopicSystem.from_matrices(mats, verts, dt)
+        raise InputError(f"[uncertainty] key 'kind' must be \"norm-bounded\" or \"polytope\"; got {kind!r}")
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
