@@ -51,3 +51,35 @@ def test_max_admissible_theta_chaser_is_the_real_bound():
     steady_state_hinf(F, H, Q, R, 3.9)
     with pytest.raises(InputError, match="theta"):
         steady_state_hinf(F, H, Q, R, 1.01 * theta_max)
+
+
+def test_one_interval_function_student_t():
+    from hinfnav.metrics.intervals import format_interval, mean_interval, t_half_width
+    from hinfnav.metrics.streaming import WindowStatistics
+
+    # Student t table: t_{0.975, 1} = 12.706, t_{0.975, 4} = 2.776 (e.g. Montgomery & Runger, Table V).
+    assert t_half_width([1.0, 3.0]) == pytest.approx(12.706 * np.sqrt(2) / np.sqrt(2), rel=1e-4)
+    x = np.array([1.0, 2.0, 4.0, 3.0, 5.0])
+    assert t_half_width(x) == pytest.approx(2.776 * x.std(ddof=1) / np.sqrt(5), rel=1e-3)
+    # 2–5 runs: the normal 1.96 is 12.706/1.96 = 6.5× to 2.776/1.96 = 1.4× too narrow (issue 22).
+    assert t_half_width(x) / (1.96 * x.std(ddof=1) / np.sqrt(5)) == pytest.approx(1.416, rel=1e-3)
+    # One run: no interval, shown as n/a (before issue 22 a zero-width interval).
+    mean, lo, hi = mean_interval([2.5])
+    assert mean == 2.5 and np.isnan(lo) and np.isnan(hi)
+    assert format_interval(lo, hi) == "n/a (1 run)"
+    ws = WindowStatistics(window=(0, 1), pooled=np.ones(2), per_run=np.ones((1, 2)), max_abs=np.ones(2))
+    assert np.all(np.isnan(ws.ci95))
+    with pytest.raises(InputError, match="level"):
+        t_half_width(x, level=1.5)
+
+
+def test_no_hand_written_normal_intervals():
+    # issue 22: nine hand-written 1.96·s/√n intervals; every interval now goes through metrics.intervals.
+    import pathlib
+    import re
+
+    root = pathlib.Path(__file__).resolve().parents[1] / "hinfnav"
+    hits = [f"{p.relative_to(root)}:{i + 1}" for p in root.rglob("*.py") if p.name != "intervals.py"
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines())
+            if re.search(r"1\.96\s*\*", line)]
+    assert not hits, hits

@@ -12,6 +12,7 @@ from .errors import (
     rms_per_run,
     window_mask,
 )
+from .intervals import format_interval, mean_interval, t_half_width
 from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
 
 __all__ = [
@@ -28,4 +29,7 @@ __all__ = [
     "monte_carlo_statistics",
     "MonteCarloStatistics",
     "WindowStatistics",
+    "t_half_width",
+    "mean_interval",
+    "format_interval",
 ]

@@ -12,6 +12,7 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
+from ...metrics.intervals import mean_interval
 from ...metrics.streaming import monte_carlo_statistics
 from .designs import load_design
 from ...estimators.registry import build_estimator
@@ -78,9 +79,8 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
     cell_p, cell_v = _axes_rms(w.per_run[:, P]), _axes_rms(w.per_run[:, V])
 
     def mc(vals):
-        mean = float(vals.mean())
-        half = float(1.96 * vals.std(ddof=1) / np.sqrt(vals.size)) if vals.size > 1 else 0.0
-        return mean, [mean - half, mean + half]
+        mean, low, high = mean_interval(vals)  # Student t; NaN bounds with one run
+        return mean, [low, high]
 
     (mp, cp), (mv, cv) = mc(cell_p), mc(cell_v)
     return {
