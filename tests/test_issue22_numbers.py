@@ -83,3 +83,86 @@ def test_no_hand_written_normal_intervals():
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines())
             if re.search(r"1\.96\s*\*", line)]
     assert not hits, hits
+
+
+def _front(rows):
+    from types import SimpleNamespace
+
+    from hinfnav.design.mixed import MixedFront
+
+    res = [SimpleNamespace(gamma_bound=b, gamma=g, h2_bound=nu) for b, g, nu in rows[:-1]]
+    h2 = SimpleNamespace(gamma_bound=None, gamma=rows[-1][1], h2_bound=rows[-1][2])
+    return MixedFront(gamma_star=0.35864435, results=tuple(res), h2_result=h2)
+
+
+# `python -m hinfnav design --objective h2` (δ̄ = 0.05) at 6da3076, before issue 22: (γ bound, certified γ, ν);
+# the mixed rows' γ certified at the synthesis variables, the H2 row's by the robust bounded real LMI.
+_BEFORE = [(0.359003, 0.359003, 0.14091141), (0.359465, 0.359465, 0.14089889), (0.360522, 0.360522, 0.14088179),
+           (0.362941, 0.362941, 0.14085965), (0.368475, 0.368475, 0.14083274), (0.381137, 0.381137, 0.14080274),
+           (0.410111, 0.410111, 0.14077322), (0.476405, 0.476403, 0.14074999), (0.628093, 0.628092, 0.14073765),
+           (0.975173, 0.975168, 0.14073399), (1.76933, 1.76926, 0.14073345), (3.58644, 3.57907, 0.14073342),
+           (None, 0.393273, 0.14073342)]
+# The same command after: every row's γ also by the robust bounded real LMI of the filter alone.
+_AFTER = [(0.359003, 0.358806, 0.14091141), (0.359465, 0.358999, 0.14089889), (0.360522, 0.359414, 0.14088179),
+          (0.362941, 0.360269, 0.14085965), (0.368475, 0.361938, 0.14083274), (0.381137, 0.364962, 0.14080274),
+          (0.410111, 0.369912, 0.14077322), (0.476405, 0.376835, 0.14074999), (0.628093, 0.384315, 0.14073765),
+          (0.975173, 0.389783, 0.14073399), (1.76933, 0.392346, 0.14073345), (3.58644, 0.39315, 0.14073342),
+          (None, 0.393273, 0.14073342)]
+
+
+def _dominated(rows, k):
+    g, nu = rows[k][1], rows[k][2]
+    return any(r[1] <= g and r[2] <= nu and (r[1] < g or r[2] < nu) for r in rows)
+
+
+@pytest.mark.parametrize("rows", [_BEFORE, _AFTER], ids=["before", "after"])
+def test_knee_is_a_certified_row_no_row_beats(rows):
+    from hinfnav.papers.sun2011.mixed_designs import certified_knee
+
+    front = _front(rows)
+    # the old knee (grid index on the requested γ) was row 6, beaten on both numbers by the H2 row
+    assert front.knee == 6 and (rows is _AFTER or _dominated(rows, 6))
+    k = certified_knee(front)
+    assert not _dominated(rows, k)
+    if rows is _AFTER:
+        assert k == 6  # certified γ 0.370 (1.03 γ*), ν 0.1407732
+
+
+def test_standalone_filters_predict_with_the_plants_input():
+    # issue 22: L1/L2/L3 predicted with u_{k-1}, the plant and Algorithm 3 with u_k. Expected: each equals the
+    # registered Algorithm 2 run through its own step contract (update told u_{k-1}, predict with u_k).
+    from hinfnav.papers.yang2020 import Scenario
+    from hinfnav.papers.yang2020.filters import build_alg2
+    from hinfnav.papers.yang2020.loop import run_closed_loop
+
+    res = run_closed_loop(Scenario(n_steps=150, step_on=50, step_off=100, settle_s=1.0), seed=3)
+    u = res.u[..., 3:6]
+    assert np.ptp(u) > 0  # the drag-free force moves: the timing matters
+    for name, mode, y in (("L1", "truncated", res.acc_clipped), ("L2", "ideal", res.acc), ("L3", "skip", res.acc_clipped)):
+        alg = build_alg2(Scenario(), mode=mode)
+        st = alg.start(np.zeros(9), None, 1)
+        for k in range(res.t.size):
+            st = alg.feed_input(st, u[:, k - 1] if k else np.zeros((1, 3)))
+            st, out = alg.update(st, y[:, k])
+            np.testing.assert_allclose(res.passive[name][:, k], out.xhat, rtol=1e-9, atol=1e-15, err_msg=f"{name} {k}")
+            st = alg.predict(st, u[:, k])
+
+
+def test_asd_statistic_and_its_sensitivity_at_one_record_length(monkeypatch):
+    from hinfnav.papers.yang2020 import Scenario, loop
+    from hinfnav.papers.yang2020.studies import asd_sensitivity, residual_spectrum, truncated
+
+    monkeypatch.setattr(loop, "BLOCK", 100)  # noise drawn in blocks of 100 steps (10 000 in the package)
+    sc = Scenario(n_steps=600, step_on=50, step_off=100, settle_s=5.0)
+    long = loop.run_closed_loop(sc, seed=1, passive=False)
+    short = loop.run_closed_loop(Scenario(n_steps=500, step_on=50, step_off=100, settle_s=5.0), seed=1,
+                                 passive=False)
+    cut = truncated(long, 500)
+    # the record of a shorter loop up to its last full noise block (issue 22: 10⁵ of the 3×10⁵ steps)
+    np.testing.assert_array_equal(cut.x[:, :500], short.x[:, :500])
+    sens = asd_sensitivity(long, lengths=(500, 600), npersegs=(400, 450), settle_s=5.0)  # bins ≤ 25 mHz
+    assert {(r["n_steps"], r["nperseg"]) for r in sens["rows"]} == {(500, 400), (500, 450), (600, 400), (600, 450)}
+    row = next(r for r in sens["rows"] if r["n_steps"] == 500 and r["nperseg"] == 450)
+    assert row["max"] == residual_spectrum(cut, "test_mass", settle_s=5.0, nperseg=450)["stats"]["max"]
+    values = [r["max"] for r in sens["rows"]]
+    assert sens["spread"] == pytest.approx(max(values) / min(values) - 1, rel=1e-12)

@@ -15,7 +15,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from .constants import REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
 from .filters import build_alg1, build_alg2
-from .loop import Alg2Bank, residual_acceleration
+from .loop import BLOCK, Alg2Bank, residual_acceleration
 
 __all__ = [
     "NPERSEG",
@@ -281,9 +281,10 @@ def replay_alg2(result, alg, steps=None):
 def truncated(result, n_steps):
     """The first ``n_steps`` steps of a loop (``n_steps + 1`` samples), as if it had been run that long.
 
-    Exact: the noise is drawn step by step in blocks and the attitude command does not depend on the
-    length, so a loop of ``n_steps`` with the same seed gives the same samples. The standalone
-    estimators are dropped.
+    Every part of the loop is causal and the attitude command does not depend on the length, so this is
+    the loop of ``n_steps`` with the same seed up to its last full block of noise draws (:data:`BLOCK`
+    steps; for a length that is a multiple of it, all but the final sample). The standalone estimators
+    are dropped.
     """
     n1 = min(as_int_at_least("n_steps", n_steps, 1) + 1, result.x.shape[1])
     cut = {k: getattr(result, k)[:, :n1] for k in ("x", "u", "drive", "acc", "xhat")}
