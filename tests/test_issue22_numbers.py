@@ -166,3 +166,65 @@ def test_asd_statistic_and_its_sensitivity_at_one_record_length(monkeypatch):
     assert row["max"] == residual_spectrum(cut, "test_mass", settle_s=5.0, nperseg=450)["stats"]["max"]
     values = [r["max"] for r in sens["rows"]]
     assert sens["spread"] == pytest.approx(max(values) / min(values) - 1, rel=1e-12)
+
+
+def test_reference_lines_and_bands_are_labelled():
+    # issue 22: unlabelled reference lines/bands in the figures. Every axhline/axvline/axhspan/axvspan/fill_between
+    # call in plotting/ and the papers' figure code passes a label (the label may be None for repeats).
+    import ast
+    import pathlib
+
+    root = pathlib.Path(__file__).resolve().parents[1] / "hinfnav"
+    files = list((root / "plotting").glob("*.py")) + list((root / "papers").glob("*/figures.py")) + [
+        root / "papers" / "attitude2018" / "chaser.py", root / "papers" / "sun2011" / "pareto.py"]
+    missing = []
+    for path in files:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("axhline", "axvline", "axhspan", "axvspan", "fill_between")
+                    and not any(k.arg == "label" for k in node.keywords)):
+                missing.append(f"{path.name}:{node.lineno}")
+    assert not missing, missing
+
+
+def test_attitude_torque_axes_in_micro_newton_metres():
+    # issue 22: a 1e-6 offset where µN·m belongs. Expected: T₀ = 1e-5 N·m (paper 002) drawn as ±10 µN·m.
+    import matplotlib.pyplot as plt
+
+    from hinfnav.papers.attitude2018.figures import plot_torque
+    from hinfnav.papers.attitude2018.scenario import Scenario as AttitudeScenario
+
+    fig, ax = plt.subplots()
+    try:
+        plot_torque(AttitudeScenario(), ax=ax, t=np.linspace(0.0, 6000.0, 400))
+        assert "µN·m" in ax.get_ylabel()
+        assert 5.0 < max(abs(v) for v in ax.get_ylim()) < 20.0
+    finally:
+        plt.close(fig)
+
+
+def test_list_parameters_as_papermill_passes_them():
+    # `papermill -p NAME VALUE` injects anything but a number, bool or None as the string given (papermill.cli).
+    from hinfnav.papers.notebooks import sequence_parameter
+
+    assert sequence_parameter("DELTA_BARS", "[0.0, 1.0]") == (0.0, 1.0)
+    assert sequence_parameter("DELTAS", "0.5") == (0.5,)
+    assert sequence_parameter("DELTAS", 0.5) == (0.5,)
+    assert sequence_parameter("NOISES", "gaussian, laplace", str) == ("gaussian", "laplace")
+    assert sequence_parameter("NOISES", ("gaussian",), str) == ("gaussian",)
+    with pytest.raises(InputError, match="DELTA_BARS"):
+        sequence_parameter("DELTA_BARS", "a, b")
+
+
+def test_claims_table_files(tmp_path):
+    from hinfnav.papers.claims_table import write_claims_table
+
+    claims = [{"claim": "L3 is biased | more than L1", "figure": "Fig 5", "statistic": "bias, N",
+               "number": {"L1": -0.074, "L3": 0.0059}, "verdict": "does not hold"}]
+    csv_path, md_path = write_claims_table(claims, tmp_path, "title")
+    text = csv_path.read_text()
+    assert text.splitlines()[0] == "id,figure,claim,statistic,number,paper,verdict"
+    assert '"{""L1"":-0.074,""L3"":0.0059}"' in text and "does not hold" in text
+    md = md_path.read_text()
+    assert md.startswith("# title") and "L3 is biased \\| more than L1" in md
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["claims.csv", "claims.md"]  # no .tmp left

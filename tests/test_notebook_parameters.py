@@ -34,7 +34,8 @@ SUN2011 = sorted(NOTEBOOKS.glob("0[1-7]_*.ipynb"))
 PARAMETERS = {
     "01_model_and_scenario": {"SEED": 7, "RUNS": 3, "DELTA_BAR": 0.2, "NOISE": "laplace"},
     "03_design_vs_delta": {
-        "DELTA_BARS": [0.0, 1.0],            # δ̄ = 0.2 is not in the sweep: the notebook must add it
+        "DELTA_BARS": "[0.0, 1.0]",          # as `papermill -p` passes a list (a string; issue 22); δ̄ = 0.2 is
+                                             # not in the sweep: the notebook must add it
         "DELTA_BAR": 0.2,
         "SIGMA_DELTA_BARS": [0.0, 0.2],
         "WORST_CASE_DELTA_BARS": [1.0],
@@ -46,7 +47,7 @@ PARAMETERS = {
     },
     "04_table1": {"RUNS": 3, "SEED": 5, "DELTA_BAR": 0.2},
     "06_fig7_uncertainty_and_non_gaussian": {
-        "SEED": 4, "RUNS": 2, "DELTA": 0.5, "NOISE": "uniform", "DELTAS": [0.5], "NOISES": ["gaussian", "laplace"],
+        "SEED": 4, "RUNS": 2, "DELTA": 0.5, "NOISE": "uniform", "DELTAS": "0.5", "NOISES": "gaussian, laplace",
     },
 }
 

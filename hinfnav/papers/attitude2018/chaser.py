@@ -292,7 +292,7 @@ def plot_chaser(study, *, axes=None, window_s=10.0):
     for row, grp in enumerate(("position", "velocity")):
         for col, i in enumerate(state.indices(grp)):
             ax = axes[row, col]
-            ax.axvline(500.0, color="k", ls=":", lw=0.8)
+            ax.axvline(500.0, color="k", ls=":", lw=0.8, label="t = 500 s" if row == col == 0 else None)
             ax.set_xlabel("time t (s)")
             ax.set_ylabel(f"{window_s:g}-s RMS of Δ{state.labels[i]} ({state.units[i]})")
             ax.grid(True, which="both", alpha=0.3)

@@ -15,7 +15,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from .constants import REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
 from .filters import build_alg1, build_alg2
-from .loop import BLOCK, Alg2Bank, residual_acceleration
+from .loop import Alg2Bank, residual_acceleration
 
 __all__ = [
     "NPERSEG",
