@@ -172,3 +172,21 @@ def test_table1_labels_and_commands_follow_the_design_bound():
         "python -m hinfnav simulate --design observer.json --no-maneuver --runs 3 --seed 5 --json")
     assert row_command("hinf_published", True, 3, 5, 0.2) == (
         "python -m hinfnav simulate --filter published_closed_loop --runs 3 --seed 5 --json")
+
+
+#: A number with a unit, a percentage or "≈ number" in prose (the quoted results a parameter can change).
+_QUOTED = re.compile(r"(?<![\w$\\^_{])\d+\.\d+\s*(?:m/s|m\b|%|mN|×|s\b)|\d+\s*%|≈\s*\d[\d.]*")
+
+
+def test_prose_after_the_parameters_says_it_describes_the_defaults():
+    """Issue 22: prose that quotes results computes them or says it describes the default parameters."""
+    offending = []
+    for path in sorted(NOTEBOOKS.glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        start = next((i for i, c in enumerate(nb.cells) if "parameters" in c.metadata.get("tags", [])), None)
+        if start is None:
+            continue
+        for i, cell in enumerate(nb.cells[start + 1:], start=start + 1):
+            if cell.cell_type == "markdown" and _QUOTED.search(cell.source) and "default parameters" not in cell.source:
+                offending.append(f"{path.name} cell {i}")
+    assert not offending, offending
