@@ -228,3 +228,14 @@ def test_claims_table_files(tmp_path):
     md = md_path.read_text()
     assert md.startswith("# title") and "L3 is biased \\| more than L1" in md
     assert sorted(p.name for p in tmp_path.iterdir()) == ["claims.csv", "claims.md"]  # no .tmp left
+
+
+def test_one_run_monte_carlo_reports_no_interval():
+    # issue 22: a 1-run Monte Carlo printed a zero-width "95 % interval"; now none (null in JSON, n/a in tables).
+    from hinfnav.papers.sun2011.report import format_simulate_report, simulate_report
+    from hinfnav.papers.sun2011.table1 import _pm
+
+    rep = simulate_report("published", runs=1)
+    assert rep["cell_mc_ci95_pos_m"] == [None, None] and rep["mc_ci95_vel_mps"][0] == [None, None, None]
+    assert "CI" not in format_simulate_report(rep)
+    assert _pm(0.18, [float("nan")] * 2) == "0.18 ± n/a (1 run)"

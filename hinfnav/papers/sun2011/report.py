@@ -75,12 +75,12 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
                                    progress=progress, maneuver=maneuver, delta=delta, discretization=discretization)
     w, st = stats["main"], stats.state
     P, V = list(st.indices("position")), list(st.indices("velocity"))
-    r = lambda a: [float(v) for v in np.asarray(a)]  # noqa: E731
+    r = lambda a: [float(v) if np.isfinite(v) else None for v in np.asarray(a)]  # noqa: E731 (no interval: None)
     cell_p, cell_v = _axes_rms(w.per_run[:, P]), _axes_rms(w.per_run[:, V])
 
     def mc(vals):
-        mean, low, high = mean_interval(vals)  # Student t; NaN bounds with one run
-        return mean, [low, high]
+        mean, low, high = mean_interval(vals)  # Student t; no interval (None, strict JSON) with one run
+        return mean, r([low, high])
 
     (mp, cp), (mv, cv) = mc(cell_p), mc(cell_v)
     return {
