@@ -263,7 +263,7 @@ def format_mixed_design_report(report):
             gb = "none (H2)" if row["gamma_bound"] is None else f"{row['gamma_bound']:.6g}"
             lines.append(f"  {gb:>14} {row['gamma']:12.6g} {row['h2_bound']:12.8g} {row['h2_lmi']:12.8g} "
                          f"{row['h2_verified']:12.8g}")
-        lines.append(f"  knee (Kneedle on the rows no row beats on both certified γ and ν): row {report['knee']}")
+        lines.append(f"  knee (Kneedle)     : row {report['knee']}, among the rows no row beats on both certified γ and ν")
         lines.append(f"                       certified γ = {report['knee_gamma']:.6g} "
                      f"({report['knee_gamma'] / report['gamma_star']:.3g} γ*), ν = {report['knee_h2_bound']:.8g}")
         lines.append(f"  front computed in {report['front_total_time_s']:.1f} s; the design below is the knee's")
