@@ -35,6 +35,8 @@ def test_every_figure_is_written(out):
         for ext in ("png", "pdf"):
             f = d / f"{name}.{ext}"
             assert f.is_file() and f.stat().st_size > 5000, f
+    # issue 22: a table file like the other papers' (the claims, CSV and Markdown)
+    assert (d / "claims.csv").read_text().startswith("id,figure,claim,") and (d / "claims.md").is_file()
 
 
 def test_summary_fields(out):

@@ -30,7 +30,9 @@ def test_design_h2_with_gamma_json(capsys, tmp_path):
 def test_design_h2_front_reports_the_knee(capsys):
     out = json.loads(_run(capsys, "--points", "2", "--json"))
     assert len(out["front"]) == 3 and out["front"][-1]["gamma_bound"] is None
-    assert out["knee"] in (0, 1) and out["knee_gamma"] == out["front"][out["knee"]]["gamma_bound"]
+    # issue 22: the knee is a row of the front (the H2 row included) chosen on its certified γ and ν
+    assert out["knee"] in (0, 1, 2) and out["knee_gamma"] == out["front"][out["knee"]]["gamma"]
+    assert out["knee_gamma_bound"] == out["front"][out["knee"]]["gamma_bound"]
     assert out["gamma_star"] < out["front"][0]["gamma_bound"]
     text = format_mixed_design_report(out)  # what the command prints without --json
     assert "knee (Kneedle)" in text and "certified ν" in text

@@ -35,14 +35,15 @@ def test_window_selects_samples():
 
 
 def test_monte_carlo_summary_interval():
-    # per-run RMS values 1 and 3: mean 2, s = √2, CI half-width 1.96·√2/√2 = 1.96
+    # per-run RMS values 1 and 3: mean 2, s = √2, CI half-width t·√2/√2 = t with the Student t quantile
+    # t_{0.975, 1} = 12.7062 (t table, 1 degree of freedom; issue 22: not the normal 1.96)
     t = np.arange(3.0)
     e = np.zeros((2, 3, 6))
     e[0, :, 0] = 1.0
     e[1, :, 0] = 3.0
     s = monte_carlo_summary(e, t, (0, 2))
     assert s.mean[0] == pytest.approx(2.0)
-    np.testing.assert_allclose(s.ci95[:, 0], [2 - 1.96, 2 + 1.96])
+    np.testing.assert_allclose(s.ci95[:, 0], [2 - 12.7062, 2 + 12.7062], atol=1e-4)
     assert s.pooled[0] == pytest.approx(np.sqrt(5.0))
 
 

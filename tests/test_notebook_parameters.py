@@ -34,7 +34,8 @@ SUN2011 = sorted(NOTEBOOKS.glob("0[1-7]_*.ipynb"))
 PARAMETERS = {
     "01_model_and_scenario": {"SEED": 7, "RUNS": 3, "DELTA_BAR": 0.2, "NOISE": "laplace"},
     "03_design_vs_delta": {
-        "DELTA_BARS": [0.0, 1.0],            # δ̄ = 0.2 is not in the sweep: the notebook must add it
+        "DELTA_BARS": "[0.0, 1.0]",          # as `papermill -p` passes a list (a string; issue 22); δ̄ = 0.2 is
+                                             # not in the sweep: the notebook must add it
         "DELTA_BAR": 0.2,
         "SIGMA_DELTA_BARS": [0.0, 0.2],
         "WORST_CASE_DELTA_BARS": [1.0],
@@ -46,7 +47,7 @@ PARAMETERS = {
     },
     "04_table1": {"RUNS": 3, "SEED": 5, "DELTA_BAR": 0.2},
     "06_fig7_uncertainty_and_non_gaussian": {
-        "SEED": 4, "RUNS": 2, "DELTA": 0.5, "NOISE": "uniform", "DELTAS": [0.5], "NOISES": ["gaussian", "laplace"],
+        "SEED": 4, "RUNS": 2, "DELTA": 0.5, "NOISE": "uniform", "DELTAS": "0.5", "NOISES": "gaussian, laplace",
     },
 }
 
@@ -171,3 +172,21 @@ def test_table1_labels_and_commands_follow_the_design_bound():
         "python -m hinfnav simulate --design observer.json --no-maneuver --runs 3 --seed 5 --json")
     assert row_command("hinf_published", True, 3, 5, 0.2) == (
         "python -m hinfnav simulate --filter published_closed_loop --runs 3 --seed 5 --json")
+
+
+#: A number with a unit, a percentage or "≈ number" in prose (the quoted results a parameter can change).
+_QUOTED = re.compile(r"(?<![\w$\\^_{])\d+\.\d+\s*(?:m/s|m\b|%|mN|×|s\b)|\d+\s*%|≈\s*\d[\d.]*")
+
+
+def test_prose_after_the_parameters_says_it_describes_the_defaults():
+    """Issue 22: prose that quotes results computes them or says it describes the default parameters."""
+    offending = []
+    for path in sorted(NOTEBOOKS.glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        start = next((i for i, c in enumerate(nb.cells) if "parameters" in c.metadata.get("tags", [])), None)
+        if start is None:
+            continue
+        for i, cell in enumerate(nb.cells[start + 1:], start=start + 1):
+            if cell.cell_type == "markdown" and _QUOTED.search(cell.source) and "default parameters" not in cell.source:
+                offending.append(f"{path.name} cell {i}")
+    assert not offending, offending

@@ -2,8 +2,10 @@
 
 Expected values: ``tests/data/sun2011_summary_seed0_runs100.json``, the
 ``summary.json`` written by ``python -m hinfnav reproduce --seed 0`` (100 runs)
-at commit 7c2aec2, before issue 7's restructuring. Tolerance 1e-9 relative
-(issue 7); the comparison is ``benchmarks/compare_summaries.py``.
+at commit 7c2aec2, before issue 7's restructuring; the 52 interval bounds
+(``mc_ci95_*``) re-recorded at issue 22, when the intervals became Student t
+(t_{0.975, 99} = 1.984 instead of 1.96; nothing else moved). Tolerance 1e-9
+relative (issue 7); the comparison is ``benchmarks/compare_summaries.py``.
 
 The rows of the filters designed here by an SDP solver (``hinf_designed``, ``hinf_observer``) are
 compared at 1e-5 relative instead: the interior-point solver's iterates depend on the BLAS kernels

@@ -29,6 +29,12 @@ def test_writes_figures_5_to_12_and_summary(summary):
     for n in range(5, 13):
         assert (out / f"fig{n}.png").stat().st_size > 0
     assert json.loads((out / "summary.json").read_text()) == s
+    # issue 22: a table file like the other papers' (the claims, CSV and Markdown)
+    assert (out / "claims.csv").read_text().startswith("id,figure,claim,") and (out / "claims.md").is_file()
+    # issue 22: every reading of the 3e-14 claim at one record length, with the statistic's sensitivity
+    assert {v["n_steps"] for v in s["asd"]["by_reading"].values()} == {s["asd"]["record_steps"]}
+    assert s["asd"]["sensitivity"]["rows"] and set(s["estimation"]["theta_readings"]) >= {"theta_star",
+                                                                                          "kalman_prediction"}
 
 
 def test_summary_fields(summary):

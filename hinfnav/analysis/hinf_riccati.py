@@ -37,8 +37,15 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_nonnegative, as_positive
 
-__all__ = ["max_admissible_theta", "steady_state_hinf"]
+__all__ = ["MAX_ITER", "max_admissible_theta", "steady_state_hinf"]
 
+#: Default cap on recursion steps. The doubling covers ``2^j - 1`` steps in
+#: ``j`` matrix updates, so 2^60 costs about 60 updates. The cap must not decide
+#: admissibility: from ``P_0 = Q`` with ``F`` close to ``I`` (e.g. the chaser,
+#: T ω₀ ≈ 1e-4) ``P_k`` grows about linearly from ``Q``, and near ``theta_max``
+#: convergence takes ~10^6 steps; a cap of 1e5 (before issue 22) made the
+#: bisection return 3.826 for a bound of 3.99989.
+MAX_ITER = 2**60
 _BLOWUP = 1e14  # growth of ||P|| relative to max(||Q||, 1) taken as divergence
 
 
@@ -177,7 +184,7 @@ def _bisect_theta(F, Q, W, Sbar, rtol, tol, max_iter):
     return lo
 
 
-def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, max_iter=100000):
+def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, max_iter=MAX_ITER):
     """Largest ``theta`` for which the steady-state H-infinity filter exists.
 
     Parameters
@@ -187,7 +194,10 @@ def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, ma
     rtol : float, optional
         Relative width of the final bisection bracket (> 0).
     tol, max_iter : optional
-        Passed to the Riccati iteration run at each trial ``theta``.
+        Passed to the Riccati iteration run at each trial ``theta``. The
+        default ``max_iter`` (:data:`MAX_ITER`, about 60 doubling updates) is
+        large enough that the cap does not decide the bound; a small cap
+        lowers it (a ``theta`` converging slowly counts as inadmissible).
 
     Returns
     -------
@@ -221,7 +231,7 @@ def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, ma
     return theta_max
 
 
-def steady_state_hinf(F, H, Q, R, theta, L=None, S=None, *, tol=1e-12, max_iter=100000):
+def steady_state_hinf(F, H, Q, R, theta, L=None, S=None, *, tol=1e-12, max_iter=MAX_ITER):
     """Steady-state covariance bound and gain of the a-priori H-infinity filter.
 
     Parameters
@@ -247,7 +257,7 @@ def steady_state_hinf(F, H, Q, R, theta, L=None, S=None, *, tol=1e-12, max_iter=
         iterates ``j = 2^k - 1``.
     max_iter : int, optional
         Largest number of recursion steps covered (doubling needs only about
-        ``log2(max_iter)`` matrix updates).
+        ``log2(max_iter)`` matrix updates); default :data:`MAX_ITER`.
 
     Returns
     -------

@@ -7,7 +7,7 @@ than the copies there): per
 window the pooled RMS and the largest absolute error per component, and per
 run its RMS per component (``runs × n`` numbers), from which the 95 %
 interval of the pooled RMS (:func:`rms_interval`), the Monte Carlo mean of
-the per-run RMS, its 95 % interval (mean ± 1.96 s/√runs) and the 2.5–97.5 % spread of
+the per-run RMS, its 95 % interval (mean ± t s/√runs, Student t) and the 2.5–97.5 % spread of
 one run follow; per run the convergence time when tolerances are given. On
 top of that, per state group (position, velocity): the RMS over the group's
 components (the root mean square of the per-axis RMS, as Table 1 of Sun 2011
@@ -21,6 +21,7 @@ import numpy as np
 
 from ..metrics.consistency import ConsistencyAccumulator
 from ..metrics.errors import window_mask
+from ..metrics.intervals import t_half_width
 from ..metrics.streaming import WindowStatistics
 
 __all__ = ["CellAccumulator", "group_summary", "rms_interval"]
@@ -138,16 +139,15 @@ def rms_interval(ms):
 
     Every run has the same number of samples in a window, so the pooled mean
     square is the mean of the runs' mean squares m̄; its 95 % interval
-    m̄ ± 1.96 s/√runs (s their standard deviation over runs) gives
+    m̄ ± t s/√runs (Student t, s their standard deviation over runs) gives
     ``sqrt(max(0, m̄ − h)), sqrt(m̄ + h)``. This is the interval to set beside a
     standard deviation such as the Kalman limit: the mean of the per-run RMS
     is smaller than the pooled RMS (Jensen's inequality), by several per cent
     when the error is correlated over the window (few independent samples per run).
     """
     ms = np.asarray(ms, dtype=float)
-    n = ms.shape[0]
     m = ms.mean(axis=0)
-    half = 1.96 * ms.std(axis=0, ddof=1) / np.sqrt(n) if n > 1 else np.zeros_like(m)
+    half = t_half_width(ms, axis=0)  # Student t; NaN with one run
     return np.sqrt(np.maximum(m - half, 0.0)), np.sqrt(m + half)
 
 
@@ -158,9 +158,8 @@ def group_summary(ws, idx):
     ms = np.mean(ws.per_run[:, idx] ** 2, axis=1)
     rlo, rhi = rms_interval(ms)
     per = np.sqrt(ms)
-    n = per.size
     mean = per.mean()
-    half = 1.96 * per.std(ddof=1) / np.sqrt(n) if n > 1 else 0.0
+    half = t_half_width(per)  # Student t; NaN with one run
     lo, hi = np.percentile(per, [2.5, 97.5])
     return {"pooled": float(np.sqrt(np.mean(ws.pooled[idx] ** 2))), "rms_ci95_low": float(rlo),
             "rms_ci95_high": float(rhi), "mean": float(mean),

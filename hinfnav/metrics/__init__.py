@@ -24,6 +24,7 @@ from .errors import (
     rms_per_run,
     window_mask,
 )
+from .intervals import format_interval, mean_interval, t_half_width
 from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
 
 __all__ = [
@@ -50,4 +51,7 @@ __all__ = [
     "DIVERGENCE_FACTOR",
     "NEES_FACTOR",
     "NIS_KEYS",
+    "t_half_width",
+    "mean_interval",
+    "format_interval",
 ]

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.exceptions import InputError
+from .intervals import t_half_width
 
 __all__ = [
     "window_mask",
@@ -155,8 +156,8 @@ class MonteCarloSummary:
     mean : ndarray, shape (n,)
         Mean over runs of the per-run RMS error (units of each component).
     ci95 : ndarray, shape (2, n)
-        95 % confidence interval of that mean (normal approximation,
-        mean ± 1.96 s/√runs).
+        95 % confidence interval of that mean (Student t,
+        :func:`hinfnav.metrics.intervals.t_half_width`; NaN with one run).
     spread95 : ndarray, shape (2, n)
         2.5 and 97.5 percentiles of the per-run RMS (what one run may give).
     pooled : ndarray, shape (n,)
@@ -175,8 +176,7 @@ def monte_carlo_summary(error, t, window):
     per_run = rms_per_run(error, t, window)
     runs = per_run.shape[0]
     mean = per_run.mean(axis=0)
-    sd = per_run.std(axis=0, ddof=1) if runs > 1 else np.zeros(per_run.shape[1])
-    half = 1.96 * sd / np.sqrt(runs)
+    half = t_half_width(per_run, axis=0)  # NaN with one run: no interval
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
     pooled = np.sqrt(np.mean(error[:, mask] ** 2, axis=(0, 1)))

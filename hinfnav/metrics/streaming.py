@@ -25,6 +25,7 @@ from ..core.exceptions import InputError
 from ..sim.montecarlo import simulate_batches
 from .consistency import NIS_KEYS, ConsistencyAccumulator, initial_scale, warn_if_diverged
 from .errors import window_mask
+from .intervals import t_half_width
 
 __all__ = ["WindowStatistics", "MonteCarloStatistics", "monte_carlo_statistics"]
 
@@ -61,10 +62,9 @@ class WindowStatistics:
 
     @property
     def ci95(self):
-        """95 % confidence interval of :attr:`mean` (mean ± 1.96 s/√runs), shape (2, n)."""
-        n = self.runs
-        sd = self.per_run.std(axis=0, ddof=1) if n > 1 else np.zeros(self.per_run.shape[1])
-        half = 1.96 * sd / np.sqrt(n)
+        """95 % confidence interval of :attr:`mean` (Student t, :func:`~hinfnav.metrics.intervals.t_half_width`;
+        NaN with one run), shape (2, n)."""
+        half = t_half_width(self.per_run, axis=0)
         return np.vstack([self.mean - half, self.mean + half])
 
     @property

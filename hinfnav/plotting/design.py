@@ -96,9 +96,9 @@ def plot_sigma(sys, *, ax, label=None, omega=None, all_values=False, gamma=None,
     else:
         artists = ax.loglog(omega, sig, label=label, **line_kw)
     if gamma is not None:
-        artists.append(ax.axhline(gamma, ls="--", lw=0.8, color=artists[0].get_color()))
+        artists.append(ax.axhline(gamma, ls="--", lw=0.8, color=artists[0].get_color(), label=f"γ = {gamma:.4g}"))
     if nyquist and sys.dt not in (True, None):
-        artists.append(ax.axvline(np.pi / sys.dt, color="0.5", lw=0.8, ls=":"))
+        artists.append(ax.axvline(np.pi / sys.dt, color="0.5", lw=0.8, ls=":", label="Nyquist π/T"))
     ax.set_xlabel("frequency ω (rad/s)")
     ax.set_ylabel(r"$\sigma(\Psi(e^{j\omega T}))$ (m or m/s per unit noise)")
     ax.grid(True, which="both", alpha=0.3)

@@ -35,6 +35,7 @@ from ...estimators.augmented import (
     AugmentedInputSTKF,
 )
 from ...metrics.errors import rms_per_run
+from ...metrics.intervals import format_interval, mean_interval
 from ...plotting.errors import new_figure
 from ...sim.montecarlo import run_estimator
 from ...sim.truth import simulate_truth
@@ -126,18 +127,18 @@ def window_stats(error, t, state, window):
     dict
         ``pos_m``/``vel_mps``: RMS over axes, runs and window (pooled);
         ``*_mean`` the mean over runs of the per-run RMS and ``*_ci95`` its
-        95 % interval (mean ± 1.96 s/√runs); ``*_axes`` per axis (pooled).
+        95 % interval (Student t, mean ± t s/√runs); ``*_axes`` per axis (pooled).
     """
     per = rms_per_run(error, t, window) ** 2
     out = {"window_s": list(window)}
     for key, grp in (("pos_m", "position"), ("vel_mps", "velocity")):
         ms = state.select(per, grp)
         run = np.sqrt(ms.mean(axis=1))
-        half = 1.96 * run.std(ddof=1) / np.sqrt(run.size) if run.size > 1 else 0.0
+        _, low, high = mean_interval(run)  # Student t; NaN bounds with one run
         out[key] = float(np.sqrt(ms.mean()))
         out[key + "_axes"] = [float(v) for v in np.sqrt(ms.mean(axis=0))]
         out[key + "_mean"] = float(run.mean())
-        out[key + "_ci95"] = [float(run.mean() - half), float(run.mean() + half)]
+        out[key + "_ci95"] = [low, high]
     return out
 
 
@@ -247,7 +248,7 @@ def format_chaser_table(study):
         for w in ("0-500", "500-1000"):
             for key in ("pos_m", "vel_mps"):
                 lo, hi = row[w][key + "_ci95"]
-                cells.append(f"{row[w][key + '_mean']:.4g} [{lo:.3g}, {hi:.3g}]")
+                cells.append(f"{row[w][key + '_mean']:.4g} [{format_interval(lo, hi, sep=', ')}]")
         lines.append(f"{name:31}" + "".join(f"{c:>27}" for c in cells))
     return "\n".join(lines)
 
@@ -291,7 +292,7 @@ def plot_chaser(study, *, axes=None, window_s=10.0):
     for row, grp in enumerate(("position", "velocity")):
         for col, i in enumerate(state.indices(grp)):
             ax = axes[row, col]
-            ax.axvline(500.0, color="k", ls=":", lw=0.8)
+            ax.axvline(500.0, color="k", ls=":", lw=0.8, label="t = 500 s" if row == col == 0 else None)
             ax.set_xlabel("time t (s)")
             ax.set_ylabel(f"{window_s:g}-s RMS of Δ{state.labels[i]} ({state.units[i]})")
             ax.grid(True, which="both", alpha=0.3)

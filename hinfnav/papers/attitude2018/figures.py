@@ -47,9 +47,9 @@ def plot_torque(scenario, *, ax, t=None):
     T = scenario.torque(t)
     artists = []
     for i, name in enumerate(("T_dx", "T_dy", "T_dz")):
-        artists += ax.plot(t, T[:, i], lw=1.0, label=f"${name}$")
+        artists += ax.plot(t, T[:, i] * 1e6, lw=1.0, label=f"${name}$")
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel("disturbance torque (N m)")
+    ax.set_ylabel("disturbance torque (µN·m)")
     ax.legend(loc="upper right")
     ax.grid(True, alpha=0.3)
     return artists
@@ -65,13 +65,13 @@ def plot_error_axes(t, series, *, axes, what="torque", styles=None):
         Error histories in error coordinates.
     axes : sequence of 3 Axes
     what : {"torque", "euler"}
-        Torque error (N·m) or Euler-angle error (deg).
+        Torque error (drawn in µN·m) or Euler-angle error (deg).
     styles : list of dict, optional
 
     Curves are drawn with the first series on top (``zorder``), and thinned to
     at most :data:`MAX_POINTS` points.
     """
-    sl, scale, unit = (slice(6, 9), 1.0, "N m") if what == "torque" else (slice(0, 3), _DEG, "deg")
+    sl, scale, unit = (slice(6, 9), 1e6, "µN·m") if what == "torque" else (slice(0, 3), _DEG, "deg")
     artists = []
     step = max(1, t.size // MAX_POINTS)
     for j, (label, err) in enumerate(series):
@@ -205,7 +205,7 @@ def fig_q_sweep(study):
             ax.loglog(Q, tot, "o-", color=color, label=f"{name.upper()} total")
             ax.loglog(Q, pos(bias), "--", color=color, lw=0.9, label=f"{name.upper()} oscillating (mean over runs)")
             ax.loglog(Q, pos(rnd), ":", color=color, lw=0.9, label=f"{name.upper()} random")
-        ax.axvline(PAPER_Q_BEST_AEKF, color="k", lw=0.6, ls="-.")
+        ax.axvline(PAPER_Q_BEST_AEKF, color="k", lw=0.6, ls="-.", label="paper's best AEKF Q")
         ax.set_xlabel("Q ((N m)²/s)")
         ax.set_ylabel(f"RMS {'Euler-angle' if what == 'euler' else 'torque'} error ({unit})")
         ax.grid(True, which="both", alpha=0.3)
@@ -223,12 +223,12 @@ def fig_error_vs_rate(study, Q=PAPER_Q_BEST_AEKF, name="aekf"):
     t = s.t[m]
     fig, axes = new_figure(3, 1, figsize=(10, 7), sharex=True)
     rate, torque = np.abs(sc.torque_rate(t)), np.abs(sc.torque(t))
-    b = np.abs(s.mean[m, 6:9])
+    b = np.abs(s.mean[m, 6:9]) * 1e6  # µN·m
     for k, ax in enumerate(axes[:, 0]):
         ax.plot(t, b[:, k], color="C0", lw=1.0, label="|oscillating torque error| (mean over runs)")
         ax.plot(t, rate[:, k] * b[:, k].max() / rate[:, k].max(), "C1--", lw=0.8, label="|dT_d/dt| (scaled)")
         ax.plot(t, torque[:, k] * b[:, k].max() / torque[:, k].max(), "C2:", lw=0.8, label="|T_d| (scaled)")
-        ax.set_ylabel(f"|ΔT| {AXES[k]} (N m)")
+        ax.set_ylabel(f"|ΔT| {AXES[k]} (µN·m)")
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel("time t (s)")
     axes[0, 0].legend(loc="upper right", fontsize=7)
@@ -261,9 +261,9 @@ def fig_tuning(study):
     labels = [s.label for s in study.st_grid]
     x = np.arange(len(labels))
     ax.bar(x - 0.2, [s.euler_deg * 1e4 for s in study.st_grid], 0.4, label="Euler (1e-4 deg)")
-    ax.bar(x + 0.2, [s.torque_Nm * 1e6 for s in study.st_grid], 0.4, label="torque (1e-6 N m)")
+    ax.bar(x + 0.2, [s.torque_Nm * 1e6 for s in study.st_grid], 0.4, label="torque (µN·m)")
     ax.set_xticks(x, labels, rotation=45, ha="right", fontsize=7)
-    ax.set_ylabel("RMS error (scaled units)")
+    ax.set_ylabel("RMS error (1e-4 deg; µN·m)")
     ax.set_title("ASTEKF at Q = 1e-16 over (ρ, β)", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(True, axis="y", alpha=0.3)

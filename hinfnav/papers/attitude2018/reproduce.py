@@ -11,6 +11,7 @@ from ...core.outputs import to_json
 from ...core.validation import as_int_at_least
 from ..notebooks import run_notebooks
 from .chaser import chaser_study, format_chaser_table, plot_chaser
+from ..claims_table import write_claims_table
 from .claims import format_claims, measure_claims
 from .constants import CITATION, PAPER_OMEGA_E_DEG_S, orbit_rate
 from .figures import (
@@ -99,7 +100,8 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
     """Regenerate paper 002's Figs 1–9, the sweeps, the claims and the chaser study into ``out_dir``.
 
     Writes ``fig1`` … ``fig9``, ``fig10_q_sweep``, ``fig11_tuning`` and (with
-    ``chaser``) ``fig12_chaser`` as PNG and PDF, and ``summary.json``.
+    ``chaser``) ``fig12_chaser`` as PNG and PDF, ``summary.json`` and the claims
+    table ``claims.csv`` / ``claims.md`` (:func:`hinfnav.papers.claims_table.write_claims_table`).
 
     Parameters
     ----------
@@ -139,6 +141,7 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
         _save(make(), out, name)
     summary = summarize(study, claims, ch)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    write_claims_table(claims, out, "Paper 002 (gyroless attitude, 2018): the claims, their statistics and verdicts")
     if notebooks:
         _execute_notebooks(out)
     if progress:

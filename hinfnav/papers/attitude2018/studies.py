@@ -22,6 +22,7 @@ from tqdm import tqdm
 
 from ...core.validation import as_int_at_least
 from ...metrics.errors import window_mask
+from ...metrics.intervals import mean_interval
 from ...sim.nonlinear import simulate_nonlinear_truth
 from ...sim.truth import Truth
 from .constants import (
@@ -141,8 +142,8 @@ class FilterStats:
     def ci95(self, what="euler"):
         """95 % interval of the mean over runs of the per-run RMS (over axes): (low, high)."""
         run = self.euler_run_deg if what == "euler" else self.torque_run_Nm
-        half = 1.96 * run.std(ddof=1) / np.sqrt(run.size) if run.size > 1 else 0.0
-        return float(run.mean() - half), float(run.mean() + half)
+        _, low, high = mean_interval(run)  # Student t; NaN bounds with one run
+        return low, high
 
 
 def _corr(a, b):

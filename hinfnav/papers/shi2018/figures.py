@@ -111,7 +111,7 @@ def fig4(gaussian, summary=None):
 
 def _mark(fig, t):
     for ax in fig.axes:
-        ax.axvline(t, color="k", lw=0.8, ls=":")
+        ax.axvline(t, color="k", lw=0.8, ls=":", label=f"t = {t:g} s")
     return fig
 
 
@@ -165,8 +165,8 @@ def plot_maneuver_bias(result, scenario, *, axes, filters=("ekf", "hbf"), span_s
             ax.set_ylabel(f"{label} ({unit})")
             ax.grid(True, alpha=0.3)
     for ax in axes:
-        artists.append(ax.axvline(scenario.maneuver_time_s, color="k", lw=0.8, ls=":"))
-    axes[1].axhline(float(scenario.maneuver_dv()[3]) / 2, color="k", lw=0.6, ls="--")
+        artists.append(ax.axvline(scenario.maneuver_time_s, color="k", lw=0.8, ls=":", label="maneuver"))
+    axes[1].axhline(float(scenario.maneuver_dv()[3]) / 2, color="k", lw=0.6, ls="--", label="half the maneuver Δv")
     axes[0].legend(loc="upper right", fontsize="small")
     return artists
 
@@ -197,7 +197,7 @@ def plot_ratio_sweep(rows, key, *, ax, title=None, paper=True):
     x = np.arange(len(rows))
     artists = list(ax.bar(x - 0.2, pos, 0.4, label="position", color="C0"))
     artists += list(ax.bar(x + 0.2, vel, 0.4, label="velocity", color="C1"))
-    artists.append(ax.axhline(1.0, color="k", lw=0.8))
+    artists.append(ax.axhline(1.0, color="k", lw=0.8, label="HBF = EKF"))
     if paper:
         p = PAPER_RESULTS["gaussian"]
         artists.append(ax.axhline(p["hbf"]["pos_m"] / p["ekf"]["pos_m"], color="C0", ls="--", lw=0.8,

@@ -14,7 +14,7 @@ Both filters run on the same truths (paired comparison). The accuracy
 statistic of a run is the RMS of its error over the window, taken over the
 three axes (``sqrt((rms_x² + rms_y² + rms_z²)/3)``, as the workbook reads Sun
 2011's Table 1); "single run" is run 0, the Monte Carlo value is the mean over
-runs with its 95 % interval (mean ± 1.96 s/√runs), and the HBF − EKF gap is
+runs with its 95 % interval (Student t, mean ± t s/√runs), and the HBF − EKF gap is
 given as the mean of the paired per-run differences with its 95 % interval.
 """
 
@@ -28,6 +28,7 @@ from ...core.progress import bar_disabled
 from ...core.validation import as_choice, as_int_at_least
 from ...estimators.huber_filter import HuberFilter
 from ...metrics.errors import window_mask
+from ...metrics.intervals import mean_interval
 from ...sim.montecarlo import check_measurement_match
 from .constants import MIXTURE_EPS, MIXTURE_RATIO
 from .filters import EKF, HBF
@@ -239,11 +240,9 @@ def accuracy(per_axis):
 
 
 def mc_interval(values):
-    """Mean over runs and its 95 % interval (normal approximation): ``(mean, [low, high])``."""
-    values = np.asarray(values, dtype=float)
-    mean = float(values.mean())
-    half = 1.96 * float(values.std(ddof=1)) / np.sqrt(values.size) if values.size > 1 else 0.0
-    return mean, [mean - half, mean + half]
+    """Mean over runs and its 95 % interval (Student t; NaN bounds with one run): ``(mean, [low, high])``."""
+    mean, low, high = mean_interval(values)
+    return mean, [low, high]
 
 
 def filter_summary(stats, window=None):

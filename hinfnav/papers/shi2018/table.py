@@ -10,6 +10,7 @@ import csv
 from pathlib import Path
 
 from ...core.exceptions import InputError
+from ...metrics.intervals import format_interval
 
 __all__ = ["TABLE_FILTERS", "table_rows", "format_table", "write_table"]
 
@@ -67,8 +68,8 @@ def format_table(summary):
         lines.append(
             f"| {r['case']} | {r['filter']} | {_f(r['paper_pos_m'])} | {_f(r['paper_vel_mps'])} | "
             f"{_f(r['run0_pos_m'])} | {_f(r['run0_vel_mps'])} | "
-            f"{_f(r['mc_mean_pos_m'])} [{_f(r['mc_ci95_pos_low_m'])}, {_f(r['mc_ci95_pos_high_m'])}] | "
-            f"{_f(r['mc_mean_vel_mps'])} [{_f(r['mc_ci95_vel_low_mps'])}, {_f(r['mc_ci95_vel_high_mps'])}] |")
+            f"{_f(r['mc_mean_pos_m'])} [{format_interval(r['mc_ci95_pos_low_m'], r['mc_ci95_pos_high_m'], sep=', ')}] | "
+            f"{_f(r['mc_mean_vel_mps'])} [{format_interval(r['mc_ci95_vel_low_mps'], r['mc_ci95_vel_high_mps'], sep=', ')}] |")
     lim = summary["kalman_limit"]
     lines.append(f"| gaussian | Kalman (Riccati) limit | | | | | {_f(lim['pos_m'])} | {_f(lim['vel_mps'])} |")
     lines.append("")

@@ -133,7 +133,7 @@ def fig4(runs, size="default"):
     known = runs[("ekf_known_input", True)]
     for i, ax in enumerate(fig.axes[:6]):
         ax.plot(known.t, known.error[0, :, i], color="0.45", lw=0.6, zorder=3)
-        ax.axvline(500.0, color="k", ls=":", lw=0.8)
+        ax.axvline(500.0, color="k", ls=":", lw=0.8, label="t = 500 s: thrust ≈ 0")
     ax0 = fig.axes[0]
     ann = ax0.annotate("500 s" if size == "single" else "t = 500 s: thrust ≈ 0", xy=(500.0, 0.97), xycoords=("data", "axes fraction"), xytext=(3, 0),
                        textcoords="offset points", fontsize=6 if size == "single" else 8, va="top", ha="left")

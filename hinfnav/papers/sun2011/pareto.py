@@ -37,7 +37,7 @@ from .constants import published_filter
 from .designs import delta_grid
 from .filters import lti_from_matrices
 from .limits import kalman_limit, lti_error_covariance
-from .mixed_designs import mixed_front_for_scenario
+from .mixed_designs import certified_knee, mixed_front_for_scenario
 from .scenario import Scenario
 
 __all__ = ["ParetoStudy", "pareto_study", "worst_h2", "robustness_cost", "format_pareto_table", "plot_front",
@@ -77,7 +77,8 @@ class ParetoStudy:
         ``maneuver`` / ``no_maneuver`` → ``(pos_m, vel_mps)`` of the predicted
         and ``..._filtered`` of the filtered Kalman limit.
     knees : dict
-        δ̄ → index of the knee in ``rows[δ̄]``.
+        δ̄ → index of the knee in ``rows[δ̄]`` (:func:`~hinfnav.papers.sun2011.mixed_designs.certified_knee`:
+        chosen on the certified γ and ν of the points and the robust H2 filter).
     settings : dict
     """
 
@@ -183,7 +184,7 @@ def pareto_study(scenario=None, delta_bars=(0.05, 1.0), *, points=12, runs=10, s
                     "observer_residual": observer_form(A_F, B_F, C_F, nominal.A, nominal.C)["residual"],
                 })
                 bar.update(1)
-            knees[db] = fr.knee
+            knees[db] = certified_knee(fr)
     kalman = {}
     for case, maneuver in (("maneuver", True), ("no_maneuver", False)):
         kl = kalman_limit(scenario, maneuver=maneuver)
@@ -201,7 +202,7 @@ def robustness_cost(study, delta_bar):
     -------
     dict
         ``gamma_star``; ``gamma_h2`` (certified γ of the robust H2 filter) and
-        ``gamma_h2_ratio`` (÷ γ*); ``knee_gamma_ratio`` (knee γ ÷ γ*);
+        ``gamma_h2_ratio`` (÷ γ*); ``knee_gamma_ratio`` (certified γ of the knee ÷ γ*);
         ``nu_first``, ``nu_h2``, ``nu_excess`` (certified ν at the first point,
         γ*(1 + 10⁻³), against the H2 end, relative); ``nu_hinf_opt`` (worst
         sampled H2 norm of the H∞ optimum); for the first point, the H∞
@@ -217,7 +218,7 @@ def robustness_cost(study, delta_bar):
         "gamma_star": fr.gamma_star,
         "gamma_h2": fr.h2_result.gamma,
         "gamma_h2_ratio": fr.h2_result.gamma / fr.gamma_star,
-        "knee_gamma_ratio": float(fr.gamma_bounds[fr.knee] / fr.gamma_star),
+        "knee_gamma_ratio": float(study.knee_row(delta_bar)["gamma"] / fr.gamma_star),
         "nu_first": first["nu"],
         "nu_h2": h2["nu"],
         "nu_excess": first["nu"] / h2["nu"] - 1.0,
@@ -282,8 +283,9 @@ def plot_front(front, *, ax, sampled=True, synthesis=True, color="C0"):
         h2 = front.h2_result
         artists += ax.plot([h2.gamma / front.gamma_star], [h2.h2_bound], "D", color="C2",
                            label=f"robust H2 filter (certified γ = {h2.gamma / front.gamma_star:.3g} γ*)")
-    k = front.knee
-    artists += ax.plot([g[k]], [env[k]], "*", ms=14, color="C3", label="knee (Kneedle)")
+    knee = (list(front.results) + [front.h2_result])[certified_knee(front)]
+    artists += ax.plot([knee.gamma / front.gamma_star], [knee.h2_bound], "*", ms=14, color="C3",
+                       label="knee (Kneedle on the certified rows)")
     ax.set_xscale("log")
     ax.set_xlabel("H∞ bound γ / γ* (–)")
     ax.set_ylabel("ν: H2 norm of Ψ (m or m/s per unit noise)")

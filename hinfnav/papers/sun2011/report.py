@@ -12,6 +12,7 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...core.provenance import provenance
 from ...core.validation import as_int_at_least
+from ...metrics.intervals import mean_interval
 from ...metrics.streaming import monte_carlo_statistics
 from .designs import load_design
 from ...estimators.registry import build_estimator
@@ -80,13 +81,12 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
                                    progress=progress, maneuver=maneuver, delta=delta, discretization=discretization)
     w, st = stats["main"], stats.state
     P, V = list(st.indices("position")), list(st.indices("velocity"))
-    r = lambda a: [float(v) for v in np.asarray(a)]  # noqa: E731
+    r = lambda a: [float(v) if np.isfinite(v) else None for v in np.asarray(a)]  # noqa: E731 (no interval: None)
     cell_p, cell_v = _axes_rms(w.per_run[:, P]), _axes_rms(w.per_run[:, V])
 
     def mc(vals):
-        mean = float(vals.mean())
-        half = float(1.96 * vals.std(ddof=1) / np.sqrt(vals.size)) if vals.size > 1 else 0.0
-        return mean, [mean - half, mean + half]
+        mean, low, high = mean_interval(vals)  # Student t; no interval (None, strict JSON) with one run
+        return mean, r([low, high])
 
     (mp, cp), (mv, cv) = mc(cell_p), mc(cell_v)
     cs = stats.consistency_summary

@@ -29,6 +29,7 @@ from ...core.validation import as_int_at_least, as_nonnegative, as_seed
 from ...core.progress import bar_disabled
 from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
+from ...metrics.intervals import format_interval, mean_interval
 from ...sim.montecarlo import run_estimator
 from ...sim.truth import simulate_truth
 from .constants import PAPER_TABLE1, published_filter
@@ -123,11 +124,9 @@ def cell_from_values(pos_run, vel_run, pos_axes0, vel_axes0):
         "vel_axes_mps": [float(v) for v in vel_axes0],
     }
     for key, vals in (("pos_m", pos_run), ("vel_mps", vel_run)):
-        n = vals.size
-        mean = float(vals.mean())
-        half = float(1.96 * vals.std(ddof=1) / np.sqrt(n)) if n > 1 else 0.0
+        mean, low, high = mean_interval(vals)  # Student t; NaN bounds with one run
         out[f"mc_mean_{key}"] = mean
-        out[f"mc_ci95_{key}"] = [mean - half, mean + half]
+        out[f"mc_ci95_{key}"] = [low, high]
         out[f"mc_spread95_{key}"] = [float(v) for v in np.percentile(vals, [2.5, 97.5])]
     return out
 
@@ -336,11 +335,13 @@ def _fmt(v, digits=3):
     if v is None:
         return "—"
     if isinstance(v, (list, tuple)):
-        return f"[{_fmt(v[0], digits)}, {_fmt(v[1], digits)}]"
+        return f"[{format_interval(v[0], v[1], f'.{digits}g', ', ')}]"
     return f"{v:.{digits}g}"
 
 
 def _pm(mean, ci):
+    if not np.all(np.isfinite(ci)):
+        return f"{mean:.3g} ± {format_interval(*ci)}"
     return f"{mean:.3g} ± {0.5 * (ci[1] - ci[0]):.1g}"
 
 

@@ -41,7 +41,7 @@ def plot_asd(f, asd, *, ax, label=None, requirement=True, **kw):
     if requirement:
         lo, hi = REQUIREMENT_BAND_HZ
         artists += ax.loglog([lo, hi], [REQUIREMENT_ASD, REQUIREMENT_ASD], "k--", lw=1.2, label="3e-14 requirement")
-        ax.axvspan(lo, hi, color="0.9", zorder=0)
+        ax.axvspan(lo, hi, color="0.9", zorder=0, label="1-30 mHz band")
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("ASD (m s$^{-2}$/$\\sqrt{\\mathrm{Hz}}$)")
     ax.grid(True, which="both", alpha=0.3)
@@ -75,7 +75,7 @@ def plot_truncated_update(yhat, S_y, lower, upper, *, ax, reading="lower"):
     side = "≤" if reading == "lower" else "≥"
     ax.fill_between(y, 0, pdf, where=mask, color="C0", alpha=0.3, label=f"reading {side} bound")
     for bound in (lower, upper):
-        ax.axvline(bound, color="r", ls="--", lw=0.8)
+        ax.axvline(bound, color="r", ls="--", lw=0.8, label="range ±6e-6 m/s²" if bound == lower else None)
     ax.axvline(yhat, color="k", ls=":", lw=0.8, label="ŷ⁻")
     ax.axvline(m, color="C0", lw=1.5, label=f"E[y | clipped] = {m:.3g}")
     ax.set_xlabel("accelerometer reading y (m/s$^2$)")
@@ -98,7 +98,7 @@ def fig5(result, *, axis=0, run=0):
     plot_series(t, result.acc_clipped[run, :n, axis][s], ax=axes[0, 0], label="clipped (what the filters get)",
                 color="k", ylabel="accelerometer (m/s$^2$)")
     for b in ACCELEROMETER_RANGE:
-        axes[0, 0].axhline(b, color="r", ls="--", lw=0.8)
+        axes[0, 0].axhline(b, color="r", ls="--", lw=0.8, label="range" if b == ACCELEROMETER_RANGE[0] else None)
     axes[0, 0].legend(loc="upper right", fontsize=8)
     ax = axes[1, 0]
     plot_series(t, 1e3 * result.f[:n, 3 + axis][s], ax=ax, label="truth", color="k", lw=1.2)

@@ -16,6 +16,7 @@ in the contract suite is ``scenario.truth_model(SUBSYSTEM_OF[name])``.
 
 import numpy as np
 
+from ...core.exceptions import InputError
 from ...estimators.extended_state import (
     ExtendedStateKalmanFilter,
     FusedExtendedStateFilter,
@@ -28,7 +29,8 @@ from .constants import ACCELEROMETER_RANGE, P0_DIAGONAL
 from .model import DRAGFREE_INDICES, dragfree_state_spec, extended_state_spec
 from .scenario import ACC_LABELS, ACC_UNITS, Y_LABELS, Y_UNITS, LinearTruth, Scenario, check_scenario
 
-__all__ = ["build_alg1", "build_alg2", "build_fused", "ESTIMATOR_NAMES", "SUBSYSTEM_OF", "L_MODES"]
+__all__ = ["build_alg1", "build_alg2", "KalmanPredictionFilter", "build_fused", "ESTIMATOR_NAMES", "SUBSYSTEM_OF",
+           "L_MODES"]
 
 #: The paper's names of the three variants of Algorithm 2 in Fig 5.
 L_MODES = {"L1": "truncated", "L2": "ideal", "L3": "skip"}
@@ -46,16 +48,34 @@ def build_alg1(scenario, *, steady_tol=None, name="yang2020_alg1"):
                                      steady_tol=steady_tol, name=name)
 
 
-def build_alg2(scenario, *, mode="truncated", steady_tol=None, name=None):
-    """Algorithm 2 on the three drag-free axes (12)-(13), accelerometer range ±6e-6 m/s²."""
+class KalmanPredictionFilter(SaturatedExtendedStateFilter):
+    """Algorithm 2 with the plain Kalman prior ``A P Aᵀ + Q₁ + Q₂`` (no θ): not the paper's, a reference.
+
+    Used to ask whether L1's bias is θ's doing (:func:`hinfnav.papers.yang2020.studies.theta_readings_study`).
+    """
+
+    def prior_covariance(self, P):
+        """``A P Aᵀ + Q₁ + Q₂`` per axis."""
+        return self.A @ P @ np.swapaxes(self.A, -1, -2) + self.Q1 + self.Q2
+
+
+def build_alg2(scenario, *, mode="truncated", steady_tol=None, name=None, theta=None, prediction="theta"):
+    """Algorithm 2 on the three drag-free axes (12)-(13), accelerometer range ±6e-6 m/s².
+
+    ``theta`` (per axis or one number; default θ* = √(4 q / tr P₀)) and ``prediction``: ``"theta"`` (the
+    paper's θ-inflated prior) or ``"kalman"`` (:class:`KalmanPredictionFilter`, θ unused).
+    """
     sc = check_scenario(scenario)
     m = sc.model
     lo, up = ACCELEROMETER_RANGE
-    return SaturatedExtendedStateFilter(
+    cls = {"theta": SaturatedExtendedStateFilter, "kalman": KalmanPredictionFilter}.get(prediction)
+    if cls is None:
+        raise InputError(f"prediction must be 'theta' or 'kalman'; got {prediction!r}")
+    return cls(
         m.axis_A_d, m.axis_B_d, m.axis_C, m.axis_D, R=sc.accel_std**2, S=sc.input_std[3:6] ** 2, q=sc.q[3:6],
         P0=P0_DIAGONAL * np.eye(3), lower=lo, upper=up, dt=sc.dt, mode=mode, state=dragfree_state_spec(),
         measurement_labels=ACC_LABELS, measurement_units=ACC_UNITS, steady_tol=steady_tol,
-        name=name or ("yang2020_alg2" if mode == "truncated" else f"yang2020_alg2_{mode}"))
+        theta=theta, name=name or ("yang2020_alg2" if mode == "truncated" else f"yang2020_alg2_{mode}"))
 
 
 def build_fused(scenario, *, covariance=None, steady_tol=None, name="yang2020_fused"):

@@ -19,7 +19,10 @@ estimate X̂⁻_k, and the compensation of the disturbance lags one step.
 Alongside, without acting on the loop, the standalone estimators of Figs 5-7
 run on the same readings: Algorithm 1 and Algorithm 2 in its three variants
 L1 (truncated-normal update), L2 (ideal: fed the unclipped readings, never
-clipped) and L3 (skips clipped readings), batched into one array.
+clipped) and L3 (skips clipped readings), batched into one array. Their timing
+is the fused filter's: the update is told the input the reading contains
+(u_{k−1}, or u_k with ``timing="prior"``), the prediction the input the plant
+moves with (u_k). (Before issue 22 L1/L2/L3 also predicted with u_{k−1}.)
 
 Randomness: run r draws from the r-th child of ``numpy.random.default_rng(seed)``,
 in blocks of ``BLOCK`` steps, w (9) then d (9) then d_a (3) per block: the same
@@ -39,7 +42,7 @@ from .filters import build_alg1, build_alg2, build_fused
 from .model import MEASURED_INDICES, disturbance
 from .scenario import CONTROLLERS, check_scenario
 
-__all__ = ["LoopResult", "run_closed_loop", "residual_acceleration", "BLOCK", "PASSIVE"]
+__all__ = ["LoopResult", "run_closed_loop", "residual_acceleration", "Alg2Bank", "BLOCK", "PASSIVE"]
 
 #: Steps per block of noise drawn at once.
 BLOCK = 10_000
@@ -144,23 +147,34 @@ def residual_acceleration(result, reading="test_mass"):
     return coupling - result.drive[..., 3:6] / M_SC
 
 
-class _Bank:
-    """L1, L2, L3 stacked as rows of one Algorithm 2 array (runs × 3 variants)."""
+class Alg2Bank:
+    """L1, L2, L3 stacked as rows of one Algorithm 2 array (runs × 3 variants).
 
-    def __init__(self, sc, runs):
-        self.alg = build_alg2(sc, mode="truncated")
+    Parameters
+    ----------
+    alg : SaturatedExtendedStateFilter
+        The Algorithm 2 whose kernels are used (``build_alg2(scenario)``; another θ or prediction for
+        :func:`hinfnav.papers.yang2020.studies.theta_readings_study`).
+    runs : int
+    """
+
+    def __init__(self, alg, runs):
+        self.alg = alg
         self.runs = runs
         self.X = np.zeros((3 * runs, 3, 3))
         self.P = np.broadcast_to(self.alg.P0, (3 * runs, 3, 3, 3)).copy()
         self.skip = np.repeat([False, False, True], runs)  # rows: L1 (runs), L2 (runs), L3 (runs)
         self.ideal = np.repeat([False, True, False], runs)
 
-    def step(self, acc_raw, acc_clipped, u_f):
+    def step(self, acc_raw, acc_clipped, u_read, u_next):
+        """Update with the readings (runs, 3), which contain the input ``u_read`` (runs, 3), N; then predict
+        over the hold of ``u_next`` (runs, 3), N, the input the plant moves with. Returns the filtered
+        ``[r, ṙ, F_Dsc]`` of L1, L2, L3, shape (3, runs, 9)."""
         y = np.concatenate([acc_clipped, acc_raw, acc_clipped])
         sat = self.alg.flags(y) & ~self.ideal[:, None]
-        uu = np.concatenate([u_f] * 3)
-        X, P, _, _, _ = self.alg.kernel_update(self.X, self.P, y, uu, sat=sat, skip=self.skip)
-        self.X, self.P = self.alg.kernel_predict(X, P, uu)
+        X, P, _, _, _ = self.alg.kernel_update(self.X, self.P, y, np.concatenate([u_read] * 3), sat=sat,
+                                               skip=self.skip)
+        self.X, self.P = self.alg.kernel_predict(X, P, np.concatenate([u_next] * 3))
         return self.alg.to_full(X).reshape(3, self.runs, 9)
 
 
@@ -210,7 +224,7 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
     if n_passive:
         a1 = build_alg1(sc, steady_tol=sc.steady_tol)
         s1 = a1.start(sc.xhat0, None, runs)
-        bank = _Bank(sc, runs)
+        bank = Alg2Bank(build_alg2(sc, mode="truncated"), runs)
     x = np.broadcast_to(sc.x0, (runs, 18)).copy()
     fs = fused.start(sc.xhat0, None, runs)
     cs = law.start(runs)
@@ -250,7 +264,7 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
             s1, o1 = a1.update(s1, Y)
             pas["alg1"][:, k] = o1.xhat[:, 9:18]
             s1 = a1.predict(s1, u)
-            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(a_raw, a_c, u_read[:, 3:6])
+            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(a_raw, a_c, u_read[:, 3:6], u[:, 3:6])
         fs = fused.predict(fs, u)
         x = x @ PhiT + g @ GamT
         u_prev, w_prev = u, wk

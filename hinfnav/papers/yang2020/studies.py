@@ -6,13 +6,16 @@ one-sided density), averaged over runs, as an amplitude spectral density in
 m·s⁻²/√Hz.
 """
 
+import dataclasses
+
 import numpy as np
 from scipy.signal import welch
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from .constants import REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
-from .loop import residual_acceleration
+from .filters import build_alg1, build_alg2
+from .loop import Alg2Bank, residual_acceleration
 
 __all__ = [
     "NPERSEG",
@@ -25,7 +28,21 @@ __all__ = [
     "step_response",
     "saturation_summary",
     "linear_loop_radius",
+    "replay_alg2",
+    "truncated",
+    "asd_sensitivity",
+    "SENSITIVITY_NPERSEG",
+    "THETA_READINGS",
+    "theta_readings_study",
 ]
+
+#: The readings of θ the L1/L3 comparison is run under: name → (factor on Algorithm 2's θ* = √(4q/tr P₀),
+#: or "alg1" for Algorithm 1's θ*, or None for the plain Kalman prediction, which is not the paper's).
+THETA_READINGS = {"theta_star": 1.0, "theta_star_x0.1": 0.1, "theta_star_x10": 10.0, "theta_alg1": "alg1",
+                  "kalman_prediction": None}
+
+#: Welch segment lengths of the sensitivity table (2^13 … 2^15 samples: 819 s … 3277 s).
+SENSITIVITY_NPERSEG = (2**13, 2**14, 2**15)
 
 #: Welch segment length: 2^15 samples = 3277 s, resolution 0.31 mHz (four bins per mHz at the band's low edge).
 NPERSEG = 2**15
@@ -227,3 +244,138 @@ def linear_loop_radius(kp, ki, kd, gain, integral_scale, h=0.1, slope=10.0):
     if ki == 0:
         A = A[:2, :2]
     return float(np.max(np.abs(np.linalg.eigvals(A))))
+
+
+def replay_alg2(result, alg, steps=None):
+    """L1, L2, L3 of an Algorithm 2 ``alg`` re-run on a loop's stored readings and inputs.
+
+    The timing is the loop's (:func:`~hinfnav.papers.yang2020.loop.run_closed_loop`): the update is told
+    the input the reading contains (u_{k−1}; u_k with ``timing="prior"``), the prediction the input the
+    plant moves with (u_k). With ``alg = build_alg2(scenario)`` it gives the loop's own L1, L2, L3.
+
+    Parameters
+    ----------
+    result : LoopResult
+    alg : SaturatedExtendedStateFilter
+    steps : int, optional
+        The first ``steps`` samples (default all).
+
+    Returns
+    -------
+    dict
+        ``L1``, ``L2``, ``L3`` → filtered ``[r, ṙ, F_Dsc]``, shape (runs, steps, 9).
+    """
+    n = result.x.shape[1] if steps is None else min(as_int_at_least("steps", steps, 1), result.x.shape[1])
+    prior = result.settings.get("timing") == "prior"
+    u = result.u[..., 3:6]
+    acc, acc_c = result.acc, result.acc_clipped
+    bank = Alg2Bank(alg, result.runs)
+    out = np.empty((3, result.runs, n, 9))
+    zero = np.zeros_like(u[:, 0])
+    for k in range(n):
+        u_read = u[:, k] if prior else (u[:, k - 1] if k else zero)
+        out[:, :, k] = bank.step(acc[:, k], acc_c[:, k], u_read, u[:, k])
+    return {"L1": out[0], "L2": out[1], "L3": out[2]}
+
+
+def truncated(result, n_steps):
+    """The first ``n_steps`` steps of a loop (``n_steps + 1`` samples), as if it had been run that long.
+
+    Every part of the loop is causal and the attitude command does not depend on the length, so this is
+    the loop of ``n_steps`` with the same seed up to its last full block of noise draws (:data:`BLOCK`
+    steps; for a length that is a multiple of it, all but the final sample). The standalone estimators
+    are dropped.
+    """
+    n1 = min(as_int_at_least("n_steps", n_steps, 1) + 1, result.x.shape[1])
+    cut = {k: getattr(result, k)[:, :n1] for k in ("x", "u", "drive", "acc", "xhat")}
+    return dataclasses.replace(result, t=result.t[:n1], f=result.f[:n1], passive={},
+                               reference=None if result.reference is None else result.reference[:n1],
+                               settings=dict(result.settings, n_steps=n1 - 1), **cut)
+
+
+def asd_sensitivity(result, reading="test_mass", *, settle_s=2000.0, lengths=None, npersegs=SENSITIVITY_NPERSEG):
+    """The Fig 12 statistic (largest one-sided Welch ASD in 1-30 mHz) against record length and ``nperseg``.
+
+    Parameters
+    ----------
+    result : LoopResult
+    reading : str
+        Residual reading (:func:`~hinfnav.papers.yang2020.loop.residual_acceleration`).
+    settle_s : float
+        Samples before it are left out, s.
+    lengths : sequence of int, optional
+        Record lengths, steps (default: the loop's own length).
+    npersegs : sequence of int
+
+    Returns
+    -------
+    dict
+        ``rows``: one dict per (length, nperseg) with ``n_steps``, ``nperseg``, ``max``, ``f_at_max_hz``
+        (m s⁻²/√Hz, Hz); ``spread``: largest / smallest ``max`` − 1 over the rows (the statistic's own
+        scatter with these choices); ``min``, ``max``.
+    """
+    lengths = [result.x.shape[1] - 1] if lengths is None else [as_int_at_least("lengths entry", n, 1) for n in lengths]
+    rows = []
+    for n in lengths:
+        part = truncated(result, n)
+        for nper in npersegs:
+            st = residual_spectrum(part, reading, settle_s=settle_s, nperseg=nper)
+            if any(r["n_steps"] == n and r["nperseg"] == st["nperseg"] for r in rows):
+                continue  # nperseg capped at a short record
+            rows.append({"n_steps": int(n), "nperseg": int(st["nperseg"]), "max": st["stats"]["max"],
+                         "f_at_max_hz": st["stats"]["f_at_max_hz"]})
+    values = np.array([r["max"] for r in rows])
+    return {"reading": reading, "convention": "one-sided Welch ASD (Hann, 50 % overlap), PSD averaged over runs",
+            "rows": rows, "min": float(values.min()), "max": float(values.max()),
+            "spread": float(values.max() / values.min() - 1.0)}
+
+
+def theta_readings_study(result, scenario, *, axis=0, readings=None):
+    """L1, L2, L3 on one loop's readings under several readings of θ, and what drives L1's bias.
+
+    Parameters
+    ----------
+    result : LoopResult
+        Usually the open drag-free loop of Fig 5 (its standalone L1/L2/L3 are the θ* reading).
+    scenario : Scenario
+    axis : int
+    readings : dict, optional
+        Default :data:`THETA_READINGS`.
+
+    Returns
+    -------
+    dict
+        Per reading: ``theta`` (per axis), and for L1, L2, L3 the :func:`disturbance_errors` (N) plus
+        ``r_error_mean_m`` / ``r_error_end_m`` (mean and final |displacement error|, m); for L1 also
+        ``first_update_N`` (its disturbance estimate after the first update) and ``truth_first_N``.
+        Also ``first_saturated_step``, ``saturated_fraction`` and ``p0_disturbance_std_N`` (√P₀ of F).
+    """
+    readings = THETA_READINGS if readings is None else readings
+    truth = result.dragfree_truth()
+    base = build_alg2(scenario)
+    sat = result.saturated[..., axis]
+    first = np.argmax(sat, axis=1)
+    out = {"first_saturated_step": int(first.min()) if sat.any() else None,
+           "saturated_fraction": float(sat.mean()), "p0_disturbance_std_N": float(np.sqrt(base.P0[axis, 2, 2]))}
+    n_p = next(iter(result.passive.values())).shape[1] if result.passive else 0
+    for name, how in readings.items():
+        if how == 1.0 and n_p == truth.shape[1]:
+            est, theta = {k: result.passive[k] for k in ("L1", "L2", "L3")}, base.theta
+        else:
+            if how is None:
+                alg = build_alg2(scenario, prediction="kalman")
+            else:
+                th = build_alg1(scenario).theta if how == "alg1" else float(how) * base.theta
+                alg = build_alg2(scenario, theta=th)
+            est, theta = replay_alg2(result, alg), (None if how is None else alg.theta)
+        row = {"theta": None if theta is None else [float(v) for v in np.broadcast_to(theta, (3,))]}
+        for k, e in est.items():
+            tr = truth[:, : e.shape[1]]
+            r_err = np.abs(e[:, :, axis] - tr[:, :, axis])
+            row[k] = dict(disturbance_errors(e, tr, axis=axis), r_error_mean_m=float(r_err.mean()),
+                          r_error_end_m=float(r_err[:, -1].mean()))
+        k = out["first_saturated_step"] or 0
+        row["L1"]["first_update_N"] = float(est["L1"][:, k, 6 + axis].mean())
+        row["L1"]["truth_first_N"] = float(truth[:, k, 6 + axis].mean())
+        out[name] = row
+    return out
