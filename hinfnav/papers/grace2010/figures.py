@@ -45,8 +45,8 @@ def mismatch_figure(prop):
              "two_body_j2": "two-body + J2, both spacecraft"}
     for key, label in names.items():
         a.loglog(t, prop["growth"][key][1:], label=label)
-    for s in prop["horizons_s"].values():
-        a.axvline(s, color="gray", ls=":", lw=0.8)
+    for i, s in enumerate(prop["horizons_s"].values()):
+        a.axvline(s, color="gray", ls=":", lw=0.8, label="1/10, 1/4 and one orbit" if i == 0 else None)
     a.axhline(RELATIVE_TRUTH_SIGMA_M, color="k", ls="--", lw=0.8, label="truth's own 1σ per axis (≈ 2.8 cm)")
     a.set_xlabel("propagation time (s); dotted: 1/10, 1/4 and one orbit")
     a.set_ylabel(f"RMS position error over {prop['starts']} starts (m)")
