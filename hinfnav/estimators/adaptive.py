@@ -236,8 +236,8 @@ class RateAdaptive:
         Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
         return Qd, {"q_used": q, "kappa_used": kappa}
 
-    def start(self, xhat0, P0=None, runs=1):
-        state = super().start(xhat0, P0, runs)
+    def _start(self, xhat0, P0, runs):
+        state = super()._start(xhat0, P0, runs)
         window = np.zeros((self.window + 1, runs, self.n_aug))
         state.extra.update(rate_window=window, rate_count=0)
         return state

@@ -188,7 +188,7 @@ class AugmentedEKF(Estimator):
 
     # -- the step contract ---------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         if self.parameter_runs is not None and runs != self.parameter_runs:
             raise InputError(f"runs must equal the number of per-run parameter values ({self.parameter_runs}); got {runs}")
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
@@ -198,7 +198,7 @@ class AugmentedEKF(Estimator):
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
-    def update(self, state, y):
+    def _update(self, state, y):
         x = state.x
         y = np.asarray(y, dtype=float)
         try:
@@ -231,7 +231,7 @@ class AugmentedEKF(Estimator):
                                    diagnostics=diag)
         return new, StepOutput(xhat=self.report(x), P=self._runs(self.report_covariance(P), runs), diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         u = None if u is None else np.asarray(u, dtype=float)

@@ -168,10 +168,10 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             x_post = x + np.einsum("rij,rj->ri", K, innovation)
         return x_post, P_post, {"theta": np.full(x.shape[0], self.theta)}
 
-    def update(self, state, y):
+    def _update(self, state, y):
         """As :meth:`ExtendedKalmanFilter.update`, without re-evaluating the (linear) measurement's Jacobian."""
         if not self.measurement.linear:
-            return super().update(state, y)
+            return super()._update(state, y)
         x, P = state.x, state.P
         H = self.measurement.H
         innovation = np.asarray(y, dtype=float) - x @ H.T
@@ -182,7 +182,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = self.predict_mean(state.x, np.asarray(u, dtype=float))
@@ -200,6 +200,12 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
                 extra["check_prior"] = P
         extra["steady"] = steady
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
+
+
+def _check_feed(self, state, u):
+    """The input a reading contains (``feed_input``): checked as ``predict`` checks u, before an ``update``."""
+    self._check_order(state, "feed_input", "prior")
+    return self._check_step_input(state, u, "feed_input")
 
 
 def _axis_arrays(name, value, shape):
@@ -246,6 +252,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     name = "saturated_eskf"
     uses_input = True
+    _check_feed = _check_feed
 
     def __init__(self, A_d, B_d, C, D, *, R, S, q, P0, lower, upper, dt, mode="truncated", state=None,
                  measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None):
@@ -384,7 +391,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     # -- the step contract ---------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         x0 = as_vector("xhat0", xhat0, self.n_state)
         X = np.broadcast_to(self.from_full(x0[None]), (runs, self.n_axes, 3)).copy()
         P = self.P0 if P0 is None else self.from_full_cov(P0)
@@ -393,10 +400,8 @@ class SaturatedExtendedStateFilter(Estimator):
 
     def feed_input(self, state, u):
         """The state with the input ``u_k`` (runs, n_axes) that the next reading contains through ``D u_k``."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (state.x.shape[0], self.n_axes):
-            raise InputError(f"u must have shape (runs, {self.n_axes}); got {u.shape}")
-        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u))
+        u = self._check_feed(state, u)
+        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u), phase=state.phase)
 
     def from_full_cov(self, P0):
         """A full (3 n_axes)² covariance → its per-axis blocks (cross-axis terms are dropped)."""
@@ -404,7 +409,7 @@ class SaturatedExtendedStateFilter(Estimator):
         na = self.n_axes
         return np.stack([P0[np.ix_(np.arange(3) * na + a, np.arange(3) * na + a)] for a in range(na)])
 
-    def update(self, state, y):
+    def _update(self, state, y):
         y = np.asarray(y, dtype=float)
         steady = state.extra.get("steady")
         cache = None if steady is None or "K" not in steady else (steady["K"], steady["P_post"])
@@ -418,7 +423,7 @@ class SaturatedExtendedStateFilter(Estimator):
         new = FilterState(x=X, P=P, k=state.k, extra=extra)
         return new, StepOutput(xhat=self.to_full(X), P=self.full_covariance(P), diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         u = np.asarray(u, dtype=float)
@@ -459,6 +464,7 @@ class FusedExtendedStateFilter(Estimator):
 
     name = "fused_eskf"
     uses_input = True
+    _check_feed = _check_feed
 
     def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None):
         if not isinstance(alg1, ExtendedStateKalmanFilter):
@@ -509,21 +515,20 @@ class FusedExtendedStateFilter(Estimator):
         P1[:, self._rr, self._cc] = Po
         return x1, P1, Xo, Po
 
-    def start(self, xhat0, P0=None, runs=1):
-        s1 = self.alg1.start(xhat0, P0, runs)
+    def _start(self, xhat0, P0, runs):
+        s1 = self.alg1._start(xhat0, P0, runs)
         x0 = np.asarray(xhat0, dtype=float)
-        s2 = self.alg2.start(x0[self.idx], None if P0 is None else np.asarray(P0)[np.ix_(self.idx, self.idx)], runs)
+        s2 = self.alg2._start(x0[self.idx], None if P0 is None else np.asarray(P0)[np.ix_(self.idx, self.idx)], runs)
         P1 = np.broadcast_to(s1.P, (runs,) + s1.P.shape[-2:]).copy()
         return FilterState(x=s1.x, P=P1, extra={"X2": s2.x, "P2": s2.P, "u_feed": s2.extra["u_feed"], "steady": None})
 
     def feed_input(self, state, u):
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (state.x.shape[0], self.n_input):
-            raise InputError(f"u must have shape (runs, {self.n_input}); got {u.shape}")
-        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]))
+        u = self._check_feed(state, u)
+        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
+                           phase=state.phase)
 
-    def update(self, state, y):
+    def _update(self, state, y):
         y = np.asarray(y, dtype=float)
         x1, P1 = state.x, state.P
         steady = state.extra["steady"]
@@ -567,7 +572,7 @@ class FusedExtendedStateFilter(Estimator):
         Xo = x1[:, self.idx].reshape(x1.shape[0], 3, -1).swapaxes(1, 2).copy()
         return x1, Xo
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         u = np.asarray(u, dtype=float)

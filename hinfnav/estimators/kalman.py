@@ -130,14 +130,14 @@ class ExtendedKalmanFilter(Estimator):
 
     # -- the step contract --------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
         x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
         if not self.shares_covariance:
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
-    def update(self, state, y):
+    def _update(self, state, y):
         x, P = state.x, state.P
         y = np.asarray(y, dtype=float)
         try:
@@ -158,7 +158,7 @@ class ExtendedKalmanFilter(Estimator):
             out = StepOutput(xhat=x, P=self._broadcast(P, x.shape[0]), diagnostics=diag)
         return new, out
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = self.predict_mean(state.x, None if u is None else np.asarray(u, dtype=float))

@@ -81,11 +81,11 @@ class LTIFilter(Estimator):
     def n_input(self):
         return 0 if self._M is None else self._M.shape[1]
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         x0 = self._CF_inv @ np.asarray(xhat0, dtype=float)
         return FilterState(x=np.broadcast_to(x0, (runs, x0.size)).copy())
 
-    def update(self, state, y):
+    def _update(self, state, y):
         state.extra["y"] = np.asarray(y, dtype=float)
         return state, StepOutput(xhat=state.x @ self.C_F.T)
 
@@ -95,7 +95,7 @@ class LTIFilter(Estimator):
             drive = drive + u @ self._M.T
         return drive
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = state.x @ self._A_eff.T + self._drive(state.extra["y"], u)

@@ -161,7 +161,7 @@ class RecursiveHInfinityFilter(Estimator):
 
     # -- the step contract --------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
         x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
         return FilterState(x=x, P=P, extra={"steady": None})
@@ -177,7 +177,7 @@ class RecursiveHInfinityFilter(Estimator):
             P_next = P
         return K, P_next, margin, ok, steady
 
-    def update(self, state, y):
+    def _update(self, state, y):
         y = np.asarray(y, dtype=float)
         runs = state.x.shape[0]
         K, P_next, margin, ok, steady = self._gain(state.P, state.k, state.extra.get("steady"))
@@ -191,7 +191,7 @@ class RecursiveHInfinityFilter(Estimator):
         new = FilterState(x=state.x, P=state.P, k=state.k, extra=extra)
         return new, StepOutput(xhat=state.x, P=np.broadcast_to(state.P, (runs,) + state.P.shape), diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         if "gain" not in state.extra:
