@@ -191,9 +191,20 @@ class StrongTracking:
             raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
         self.a = a
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
-        V0 = innovation_moment(state.extra.get("V0"), innovation, self.rho)
-        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, self.R, beta=self.beta, a=self.a)
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """(S1)-(S4). With missing channels (``~mask``; innovation and H zero there) the moment and N use the
+        channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
+        V0_old = state.extra.get("V0")
+        V0 = innovation_moment(V0_old, innovation, self.rho)
+        R = self.R
+        if mask is not None:
+            gone = ~mask.any(axis=1)
+            if V0_old is not None:
+                V0 = np.where(gone[:, None, None], V0_old, V0)
+            R = np.where(mask[:, :, None] & mask[:, None, :], R, 0.0)
+        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, R, beta=self.beta, a=self.a)
+        if mask is not None:
+            lam = np.where(gone[:, None], 1.0, lam)
         P = fade(PhiPPhiT, lam) + Qd
         return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, {"V0": V0}
 

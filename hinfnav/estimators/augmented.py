@@ -28,35 +28,17 @@ its covariance is shared by every run.
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance, congruence, inv_spd, matmul_shared
+from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import drop_missing, joseph_update
 from .kalman import OUTPUTS
 
-__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF", "joseph_update"]
+__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF"]
 
 #: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
 _TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
-
-
-def joseph_update(P, H, R, innovation):
-    """Kalman correction (E2), batched; returns ``(δx, P⁺)``.
-
-    ``P`` is (n, n) shared with ``H`` (m, n), or per run (runs, n, n) with
-    ``H`` (m, n) or (runs, m, n).
-    """
-    HT = np.swapaxes(H, -1, -2)
-    PHT = matmul_shared(P, HT)
-    S = H @ PHT + R if PHT.ndim == 2 else matmul_shared(np.swapaxes(PHT, -1, -2), HT) + R  # H P Hᵀ + R (P symmetric)
-    K = PHT @ inv_spd(S)
-    if K.ndim == 2:
-        dx = innovation @ K.T
-    else:
-        dx = (K @ innovation[..., None])[..., 0]
-    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
-    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
-    return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
 
 
 class AugmentedEKF(Estimator):
@@ -170,8 +152,11 @@ class AugmentedEKF(Estimator):
         """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
         return self.Qd, {}
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
-        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1)."""
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1).
+
+        ``innovation`` and ``H`` are zero on the channels ``~mask`` a reading lacks (mask None: none).
+        """
         return PhiPPhiT + Qd, {}, {}
 
     def after_update(self, state, x_post):
@@ -200,32 +185,39 @@ class AugmentedEKF(Estimator):
 
     def _update(self, state, y):
         x = state.x
-        y = np.asarray(y, dtype=float)
         try:
             yhat, H = self.observe(x)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         innovation = self.measurement.residual(y, yhat)
+        mask = available_channels(y) if self.missing == "skip" else None
+        R, used = self.R, innovation
+        if mask is not None:
+            _, H, R, used = drop_missing(state.P, H, R, innovation, mask)
         diag = self.initial_diagnostics(x.shape[0])
         diag.update(self.step_diagnostics(state))
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         if "PhiPPhiT" in state.extra:
-            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, innovation, H)
+            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, used, H,
+                                                        mask=mask)
             diag.update(d_hook)
             extra.update(e_hook)
         else:
             P = state.P
+        if mask is not None:
+            P, H, R, used = drop_missing(P, H, R, used, mask)
         try:
-            dx, P_post = joseph_update(P, H, self.R, innovation)
+            dx, P_post, S = joseph_update(P, H, R, used)
         except np.linalg.LinAlgError:
-            dx = P_post = np.array(np.nan)
+            dx = P_post = S = np.array(np.nan)
         if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         x_post = self.inject(x, dx)
         extra.update(self.after_update(state, x_post))
-        diag.update(innovation=innovation, input_estimate=self.augmented(x_post))
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         runs = x.shape[0]
+        diag.update(innovation=innovation, input_estimate=self.augmented(x_post),
+                    innovation_covariance=S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         if self.output == "filtered":
             return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
                                    diagnostics=diag)
@@ -234,7 +226,6 @@ class AugmentedEKF(Estimator):
     def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        u = None if u is None else np.asarray(u, dtype=float)
         Qd, e_noise = self.process_noise(state)
         Phi = self.transition(state.x, u)
         x = self.propagate_mean(state.x, u)

@@ -38,12 +38,13 @@ import numpy as np
 
 from ..analysis.truncated import truncated_normal_moments
 from ..core.exceptions import InputError
-from ..core.linalg import as_covariance, inv_spd
+from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_positive, as_vector
 from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import drop_missing, kalman_gain
 from .kalman import ExtendedKalmanFilter
 
 __all__ = ["ExtendedStateKalmanFilter", "SaturatedExtendedStateFilter", "FusedExtendedStateFilter",
@@ -145,18 +146,20 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` (Algorithm 1)."""
         return (1.0 + self.theta) * (self.F @ P @ self.F.T) + self.Q
 
-    def gain(self, P_prior):
-        """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run)."""
-        H = self.measurement.H
-        PHT = P_prior @ H.T
-        K = PHT @ inv_spd(H @ PHT + self.R)
-        I_KH = self._I - K @ H
-        P_post = I_KH @ P_prior @ np.swapaxes(I_KH, -1, -2) + K @ self.R @ np.swapaxes(K, -1, -2)
+    def gain(self, P_prior, H=None, R=None):
+        """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run).
+
+        ``H``, ``R`` default to the measurement's; :func:`~hinfnav.estimators.correction.kalman_gain`.
+        """
+        K, P_post, _ = kalman_gain(P_prior, self.measurement.H if H is None else H, self.R if R is None else R,
+                                   symmetrize=False)
         return K, P_post
 
-    def correct(self, x, P, H, innovation, state):
+    def correct(self, x, P, H, innovation, state, R=None):
         steady = state.extra.get("steady")
-        if steady is not None and "K" in steady:
+        if R is not None:  # missing channels: this step's gain, not the steady one
+            K, P_post = self.gain(P, H, R)
+        elif steady is not None and "K" in steady:
             K, P_post = steady["K"], steady["P_post"]
         else:
             K, P_post = self.gain(P)
@@ -169,13 +172,18 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         return x_post, P_post, {"theta": np.full(x.shape[0], self.theta)}
 
     def _update(self, state, y):
-        """As :meth:`ExtendedKalmanFilter.update`, without re-evaluating the (linear) measurement's Jacobian."""
+        """As :meth:`ExtendedKalmanFilter._update`, without re-evaluating the (linear) measurement's Jacobian."""
         if not self.measurement.linear:
             return super()._update(state, y)
         x, P = state.x, state.P
         H = self.measurement.H
-        innovation = np.asarray(y, dtype=float) - x @ H.T
-        x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        innovation = y - x @ H.T
+        mask = available_channels(y) if self.missing == "skip" else None
+        if mask is None:
+            x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        else:
+            P, H_used, R_used, used = drop_missing(P, H, self.R, innovation, mask)
+            x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
         diag["innovation"] = innovation
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":

@@ -24,9 +24,10 @@ The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance, congruence, inv_spd
+from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import drop_missing, joseph_update
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 
@@ -58,12 +59,17 @@ class ExtendedKalmanFilter(Estimator):
     output : {"filtered", "predicted"}
         What ``update`` reports: x̂(k|k) (uses y_k) or x̂(k|k−1).
     name : str
+    missing : {"refuse", "skip"}
+        A NaN channel of a reading: an InputError, or not used at that step
+        (removed exactly, :func:`~hinfnav.estimators.correction.drop_missing`;
+        a reading without any channel leaves the prior as the estimate).
     """
 
     name = "ekf"
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None):
-        super().__init__(system, measurement, name=name)
+    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
+                 missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         n, m = system.n, measurement.n_meas
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
         #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
@@ -109,24 +115,17 @@ class ExtendedKalmanFilter(Estimator):
         return None if self.R_of_reading is None else self.R_of_reading(y)
 
     def correct(self, x, P, H, innovation, state, R=None):
-        """Joseph-form Kalman update; returns ``(x⁺, P⁺, diagnostics)``.
+        """Joseph-form Kalman update (:func:`~hinfnav.estimators.correction.joseph_update`).
 
-        ``H`` is (m, n) when P is shared, (runs, m, n) otherwise; ``R`` is
-        the step's covariance when it depends on the reading (default the
-        constant :attr:`R`).
+        Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
+        (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
+        on the reading or on the missing channels (default the constant
+        :attr:`R`). Diagnostics: ``innovation_covariance`` S (runs, m, m).
         """
         R = self.R if R is None else R
-        HT = np.swapaxes(H, -1, -2)
-        PHT = P @ HT
-        S = H @ PHT + R
-        K = PHT @ inv_spd(S)
-        if K.ndim == 2:
-            x_post = x + innovation @ K.T
-        else:
-            x_post = x + np.einsum("rij,rj->ri", K, innovation)
-        I_KH = self._I - K @ H
-        P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
-        return x_post, P_post, {}
+        dx, P_post, S = joseph_update(P, H, R, innovation, symmetrize=False)
+        runs = x.shape[0]
+        return x + dx, P_post, {"innovation_covariance": S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape)}
 
     # -- the step contract --------------------------------------------------------
 
@@ -139,17 +138,21 @@ class ExtendedKalmanFilter(Estimator):
 
     def _update(self, state, y):
         x, P = state.x, state.P
-        y = np.asarray(y, dtype=float)
         try:
             H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
             innovation = self.measurement.residual(y, self.measurement.function(x))
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         R_k = self.measurement_covariance(y, x)
-        if R_k is None:
-            x_post, P_post, diag = self.correct(x, P, H, innovation, state)
-        else:
+        mask = available_channels(y) if self.missing == "skip" else None
+        if mask is None:
             x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
+        else:
+            if R_k is not None:  # a reading-dependent R not finite on the channels it has: the reading is not used
+                both = mask[:, :, None] & mask[:, None, :]
+                mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
+            P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+            x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
         diag = dict(diag, innovation=innovation)
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":
@@ -161,7 +164,7 @@ class ExtendedKalmanFilter(Estimator):
     def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        x = self.predict_mean(state.x, None if u is None else np.asarray(u, dtype=float))
+        x = self.predict_mean(state.x, u)
         P = self.predict_covariance(state.P, state)
         extra = {key: val for key, val in state.extra.items() if key != "prior"}
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
