@@ -196,17 +196,22 @@ class StrongTracking:
         channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
         V0_old = state.extra.get("V0")
         V0 = innovation_moment(V0_old, innovation, self.rho)
-        R = self.R
+        R, keep = self.R, {}
+        if mask is not None or "V0_started" in state.extra:  # some run has skipped a whole reading
+            runs = innovation.shape[0]
+            gone = np.zeros(runs, dtype=bool) if mask is None else ~mask.any(axis=1)
+            started = state.extra.get("V0_started", np.full(runs, V0_old is not None))
+            fresh = innovation_moment(None, innovation, self.rho)
+            if V0_old is not None:  # (S1) from γγᵀ in the runs without a moment yet; unchanged in the skipped ones
+                V0 = np.where(gone[:, None, None], V0_old, np.where(started[:, None, None], V0, fresh))
+            keep = {"V0_started": started | ~gone}
         if mask is not None:
-            gone = ~mask.any(axis=1)
-            if V0_old is not None:
-                V0 = np.where(gone[:, None, None], V0_old, V0)
             R = np.where(mask[:, :, None] & mask[:, None, :], R, 0.0)
         lam, c = fading_factors(V0, H, PhiPPhiT, Qd, R, beta=self.beta, a=self.a)
         if mask is not None:
             lam = np.where(gone[:, None], 1.0, lam)
         P = fade(PhiPPhiT, lam) + Qd
-        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, {"V0": V0}
+        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
 
     def initial_diagnostics(self, runs):
         out = super().initial_diagnostics(runs)

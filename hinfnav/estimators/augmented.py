@@ -189,8 +189,10 @@ class AugmentedEKF(Estimator):
             yhat, H = self.observe(x)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
-        innovation = self.measurement.residual(y, yhat)
         mask = available_channels(y) if self.missing == "skip" else None
+        if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
+            y = np.where(mask, y, yhat)
+        innovation = self.measurement.residual(y, yhat)
         R, used = self.R, innovation
         if mask is not None:
             _, H, R, used = drop_missing(state.P, H, R, innovation, mask)

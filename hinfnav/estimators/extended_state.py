@@ -263,7 +263,8 @@ class SaturatedExtendedStateFilter(Estimator):
     _check_feed = _check_feed
 
     def __init__(self, A_d, B_d, C, D, *, R, S, q, P0, lower, upper, dt, mode="truncated", state=None,
-                 measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None):
+                 measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None,
+                 missing="refuse"):
         A_d = np.asarray(A_d, dtype=float)
         if A_d.ndim != 3 or A_d.shape[1:] != (3, 3):
             raise InputError(f"A_d must have shape (n_axes, 3, 3); got {A_d.shape}")
@@ -316,7 +317,7 @@ class SaturatedExtendedStateFilter(Estimator):
         system = LinearSystem(Phi, Gam, np.zeros((3 * na, 1)), as_positive("dt", dt), state, name="per-axis [r, v, f]")
         meas = Saturated(LinearMeasurement(Cm, np.diag(np.sqrt(self.Reff)), labels=measurement_labels,
                                            units=measurement_units), self.lower, self.upper)
-        super().__init__(system, meas, name=name)
+        super().__init__(system, meas, name=name, missing=missing)
         self._I3 = np.eye(3)
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
 
@@ -348,15 +349,24 @@ class SaturatedExtendedStateFilter(Estimator):
             return np.zeros(np.shape(y), dtype=bool)
         return (y <= self.lower) | (y >= self.upper)
 
-    def kernel_update(self, X, P, y, u_feed, cache=None, sat=None, skip=None):
+    def kernel_update(self, X, P, y, u_feed, cache=None, sat=None, skip=None, missing=None):
         """One measurement update on arrays ``X`` (runs, n_axes, 3), ``P`` (runs, n_axes, 3, 3).
 
         ``y``, ``u_feed`` (runs, n_axes): readings and the input they contain. ``cache = (K, P_post)`` of a
         converged recursion is used when no reading is clipped; ``sat`` (default :meth:`flags`) marks the
         clipped readings, ``skip`` (default ``mode == "skip"``, per run or per reading) those to skip rather
-        than replace by the truncated moments. Returns ``(X, P, innovation, flags, K)``.
+        than replace by the truncated moments; ``missing`` (runs, n_axes) marks readings that are not there
+        (NaN; their gain is 0, so the update keeps the prediction, exactly). Returns
+        ``(X, P, innovation, flags, K)``.
         """
         yhat = (X[..., None, :] @ self._Ccol)[..., 0, 0] + self.Dff * u_feed
+        if missing is not None and missing.any():
+            y = np.where(missing, yhat, y)
+            sat = (self.flags(y) if sat is None else sat) & ~missing
+            skip = (self.mode == "skip") if skip is None else skip
+            skip = np.reshape(skip, np.shape(skip) + (1,) * (missing.ndim - np.ndim(skip))) | missing
+            sat = sat | missing  # handled as skipped readings
+            cache = None
         sat = self.flags(y) if sat is None else sat
         any_sat = sat.any()
         if cache is not None and not any_sat:
@@ -421,7 +431,14 @@ class SaturatedExtendedStateFilter(Estimator):
         y = np.asarray(y, dtype=float)
         steady = state.extra.get("steady")
         cache = None if steady is None or "K" not in steady else (steady["K"], steady["P_post"])
-        X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], cache)
+        miss = np.isnan(y) if self.missing == "skip" else None
+        if miss is not None and miss.any():
+            X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], missing=miss)
+            sat = sat & ~miss
+            innov = np.where(miss, np.nan, innov)
+            steady = None if steady is None else {key: v for key, v in steady.items() if key not in ("K", "P_post")}
+        else:
+            X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], cache)
         if steady is not None and sat.any():
             steady = None  # a clipped reading: the covariance depends on the data again
         elif steady is not None and "K" not in steady:
@@ -474,7 +491,8 @@ class FusedExtendedStateFilter(Estimator):
     uses_input = True
     _check_feed = _check_feed
 
-    def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None):
+    def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None,
+                 missing="refuse"):
         if not isinstance(alg1, ExtendedStateKalmanFilter):
             raise InputError(f"alg1 must be an ExtendedStateKalmanFilter; got {type(alg1).__name__}")
         if not isinstance(alg2, SaturatedExtendedStateFilter):
@@ -503,7 +521,7 @@ class FusedExtendedStateFilter(Estimator):
                                            units=alg1.measurement.units + alg2.measurement.units),
                          np.r_[np.full(m1, -np.inf), alg2.lower],
                          np.r_[np.full(m1, np.inf), alg2.upper])
-        super().__init__(alg1.system, meas, name=name)
+        super().__init__(alg1.system, meas, name=name, missing=missing)
         self._m1 = m1
 
     def fuse(self, x1, P1, X2, P2):
@@ -542,6 +560,32 @@ class FusedExtendedStateFilter(Estimator):
         steady = state.extra["steady"]
         a1 = self.alg1
         innov1 = y[:, : self._m1] - x1 @ a1.measurement.H.T
+        miss = np.isnan(y) if self.missing == "skip" else None
+        if miss is not None and miss.all():  # no reading at all: the prediction is the estimate (no fusion either)
+            runs = x1.shape[0]
+            th1, th2 = self._thetas(runs)
+            diag = {"innovation": np.full(y.shape, np.nan), "saturated": np.zeros((runs, self.alg2.n_axes), dtype=bool),
+                    "theta": th1, "theta_alg2": th2}
+            return (FilterState(x=x1, P=P1, k=state.k, extra=dict(state.extra)),
+                    StepOutput(xhat=x1, P=P1, diagnostics=diag))
+        if miss is not None and miss.any():  # this step's gains, without the missing channels (exact)
+            X2, P2, innov2, sat, _ = self.alg2.kernel_update(state.extra["X2"], state.extra["P2"], y[:, self._m1:],
+                                                             state.extra["u_feed"], missing=miss[:, self._m1:])
+            sat = sat & ~miss[:, self._m1:]
+            P1m, H1, R1, used = drop_missing(P1, a1.measurement.H, a1.R, innov1, ~miss[:, : self._m1])
+            K1, P1p = a1.gain(P1m, H1, R1)
+            x1 = x1 + (K1 @ used[..., None])[..., 0] if K1.ndim == 3 else x1 + used @ K1.T
+            x1, P1, X2, P2 = self.fuse(x1, np.broadcast_to(P1p, P1.shape), X2, P2)
+            innov2 = np.where(miss[:, self._m1:], np.nan, innov2)
+            if steady is not None:
+                steady = None if sat.any() else {key: v for key, v in steady.items()
+                                                 if key not in ("K1", "K2", "P1_post", "P2_post")}
+            runs = x1.shape[0]
+            th1, th2 = self._thetas(runs)
+            diag = {"innovation": np.concatenate([innov1, innov2], axis=1), "saturated": sat, "theta": th1,
+                    "theta_alg2": th2}
+            extra = dict(state.extra, X2=X2, P2=P2, steady=steady)
+            return FilterState(x=x1, P=P1, k=state.k, extra=extra), StepOutput(xhat=x1, P=P1, diagnostics=diag)
         cache2 = None if steady is None or "K2" not in steady else (steady["K2"], steady["P2_post"])
         X2, P2, innov2, sat, K2 = self.alg2.kernel_update(state.extra["X2"], state.extra["P2"], y[:, self._m1:],
                                                           state.extra["u_feed"], cache2)

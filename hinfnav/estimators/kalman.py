@@ -138,13 +138,16 @@ class ExtendedKalmanFilter(Estimator):
 
     def _update(self, state, y):
         x, P = state.x, state.P
+        mask = available_channels(y) if self.missing == "skip" else None
         try:
             H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
-            innovation = self.measurement.residual(y, self.measurement.function(x))
+            yhat = self.measurement.function(x)
+            if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
+                y = np.where(mask, y, yhat)
+            innovation = self.measurement.residual(y, yhat)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         R_k = self.measurement_covariance(y, x)
-        mask = available_channels(y) if self.missing == "skip" else None
         if mask is None:
             x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
         else:
@@ -153,7 +156,7 @@ class ExtendedKalmanFilter(Estimator):
                 mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
             P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
             x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
-        diag = dict(diag, innovation=innovation)
+        diag = dict(diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":
             out = StepOutput(xhat=x_post, P=self._broadcast(P_post, x.shape[0]), diagnostics=diag)

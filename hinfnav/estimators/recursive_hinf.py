@@ -76,6 +76,10 @@ class RecursiveHInfinityFilter(Estimator):
         :class:`~hinfnav.core.exceptions.InputError` naming θ (default), or
         set ``existence_ok`` False in the diagnostics and go on with the
         same formulas (P may then lose definiteness).
+    missing : {"refuse", "skip"}
+        A NaN channel: an InputError, or its innovation set to 0 (the reading
+        the filter predicts). The gain sequence does not depend on the data
+        and is kept (documented choice: P then assumes the channel was read).
     name : str
 
     Notes
@@ -88,8 +92,8 @@ class RecursiveHInfinityFilter(Estimator):
     name = "recursive_hinf"
 
     def __init__(self, system, measurement, *, theta, P0, Q=None, R=None, L=None, S=None, uses_input=True,
-                 on_violation="raise", name=None):
-        super().__init__(system, measurement, name=name)
+                 on_violation="raise", name=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         if not getattr(measurement, "linear", False) or measurement.H is None:
             raise InputError(f"measurement must be linear (y = H x + D v); got {type(measurement).__name__}")
         n, m = system.n, measurement.n_meas
@@ -182,6 +186,8 @@ class RecursiveHInfinityFilter(Estimator):
         runs = state.x.shape[0]
         K, P_next, margin, ok, steady = self._gain(state.P, state.k, state.extra.get("steady"))
         innovation = y - state.x @ self.H.T
+        if self.missing == "skip":
+            innovation = np.where(np.isnan(innovation), 0.0, innovation)  # a missing channel: its predicted reading
         diag = {
             "innovation": innovation,
             "existence_margin": np.full(runs, margin),
@@ -207,7 +213,7 @@ class RecursiveHInfinityFilter(Estimator):
         """Batch path: the (data-independent) gain sequence once, then all runs at once; same numbers as the steps."""
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None)
+                                             self.n_input if self.uses_input else None, self.missing)
         diagnostics = keys is None or bool(keys)
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)
@@ -231,6 +237,8 @@ class RecursiveHInfinityFilter(Estimator):
         for k in range(n1):
             xhat[:, k] = x
             e = y[:, k] - x @ Ht
+            if self.missing == "skip":
+                e = np.where(np.isnan(e), 0.0, e)
             if diagnostics:
                 innov[:, k] = e
             if k < n1 - 1:
