@@ -31,8 +31,9 @@ from ..core.exceptions import InputError
 from ..systems.attitude import TORQUE, AttitudeSystem, StarSensorVectors
 from .adaptive import RateAdaptive, StrongTracking
 from .augmented import AugmentedEKF
+from .huber_filter import HuberCorrection
 
-__all__ = ["AttitudeAAEKF", "AttitudeAEKF", "AttitudeASTEKF"]
+__all__ = ["AttitudeAAEKF", "AttitudeAEKF", "AttitudeASTEKF", "AttitudeHuberEKF", "AttitudeHuberSTEKF"]
 
 
 class AttitudeAEKF(AugmentedEKF):
@@ -116,3 +117,21 @@ class AttitudeAAEKF(RateAdaptive, AttitudeAEKF):
     """
 
     name = "aaekf"
+
+
+class AttitudeHuberEKF(HuberCorrection, AttitudeAEKF):
+    """:class:`AttitudeAEKF` whose correction is Huber's M-estimation (Karlgaard & Schaub 2007).
+
+    Extra parameters ``gamma``, ``tol``, ``max_iter``; see
+    :class:`~hinfnav.estimators.huber_filter.HuberCorrection`. The regression
+    is solved for the 9 error coordinates and injected as the AEKF's
+    correction (multiplicative for the quaternion).
+    """
+
+    name = "huber_aekf"
+
+
+class AttitudeHuberSTEKF(HuberCorrection, StrongTracking, AttitudeAEKF):
+    """Huber correction with strong tracking on the attitude filter (both mixins on :class:`AttitudeAEKF`)."""
+
+    name = "huber_astekf"

@@ -32,16 +32,18 @@ from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels
-from .correction import drop_missing, joseph_update
+from .correction import KalmanCorrection, drop_missing
+from .huber_filter import HuberCorrection
 from .kalman import OUTPUTS
 
-__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF"]
+__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputHuberSTKF", "AugmentedInputKF",
+           "AugmentedInputSTKF"]
 
 #: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
 _TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
 
 
-class AugmentedEKF(Estimator):
+class AugmentedEKF(KalmanCorrection, Estimator):
     """EKF in error coordinates with augmented random-walk states (E1)–(E2); see the module docstring.
 
     Parameters
@@ -209,16 +211,15 @@ class AugmentedEKF(Estimator):
         if mask is not None:
             P, H, R, used = drop_missing(P, H, R, used, mask)
         try:
-            dx, P_post, S = joseph_update(P, H, R, used)
+            dx, P_post, d_corr = self.correct_error(P, H, R, used)
         except np.linalg.LinAlgError:
-            dx = P_post = S = np.array(np.nan)
+            dx = P_post = np.array(np.nan)
         if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         x_post = self.inject(x, dx)
         extra.update(self.after_update(state, x_post))
         runs = x.shape[0]
-        diag.update(innovation=innovation, input_estimate=self.augmented(x_post),
-                    innovation_covariance=S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape))
+        diag.update(d_corr, innovation=innovation, input_estimate=self.augmented(x_post))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         if self.output == "filtered":
             return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
@@ -335,3 +336,14 @@ class AugmentedInputAdaptiveKF(RateAdaptive, AugmentedInputKF):
     """:class:`AugmentedInputKF` whose input noise follows the input's estimated rate (``window``, ``epsilon``, ``floor``)."""
 
     name = "augmented input adaptive kf"
+
+
+class AugmentedInputHuberSTKF(HuberCorrection, StrongTracking, AugmentedInputKF):
+    """Huber × strong tracking: :class:`AugmentedInputSTKF` whose correction is Huber's M-estimation.
+
+    Extra parameters ``gamma``, ``tol``, ``max_iter``
+    (:class:`~hinfnav.estimators.huber_filter.HuberCorrection`) and ``rho``,
+    ``beta``, ``a`` (:class:`~hinfnav.estimators.adaptive.StrongTracking`).
+    """
+
+    name = "augmented input huber stkf"

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..core.linalg import inv_spd, matmul_shared
 
-__all__ = ["drop_missing", "joseph_update", "kalman_gain"]
+__all__ = ["KalmanCorrection", "drop_missing", "joseph_update", "kalman_gain"]
 
 
 def _swap(M):
@@ -114,3 +114,21 @@ def joseph_update(P, H, R, innovation, *, symmetrize=True):
     else:
         dx = (K @ innovation[..., None])[..., 0]
     return dx, P_post, S
+
+
+class KalmanCorrection:
+    """The correction hook shared by both Kalman cores: (J1)-(J2) in error coordinates.
+
+    ``correct_error(P, H, R, innovation) -> (δx, P⁺, diagnostics)``; the
+    diagnostics hold ``innovation_covariance`` S, (runs, m, m). A mixin such
+    as :class:`~hinfnav.estimators.huber_filter.HuberCorrection` replaces it
+    (the Huber M-estimation) on any filter that has it.
+    """
+
+    #: Return the symmetric part of P⁺ (the augmented core) or (J2) as computed (the EKF).
+    symmetric_posterior = True
+
+    def correct_error(self, P, H, R, innovation):
+        dx, P_post, S = joseph_update(P, H, R, innovation, symmetrize=self.symmetric_posterior)
+        runs = innovation.shape[0]
+        return dx, P_post, {"innovation_covariance": S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape)}

@@ -27,7 +27,7 @@ from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .base import Estimator, FilterState, StepOutput, available_channels
-from .correction import drop_missing, joseph_update
+from .correction import KalmanCorrection, drop_missing
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 
@@ -35,7 +35,7 @@ __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 OUTPUTS = ("filtered", "predicted")
 
 
-class ExtendedKalmanFilter(Estimator):
+class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     """Extended Kalman filter of a linear system with any measurement model.
 
     Parameters
@@ -66,6 +66,7 @@ class ExtendedKalmanFilter(Estimator):
     """
 
     name = "ekf"
+    symmetric_posterior = False
 
     def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
                  missing="refuse"):
@@ -115,17 +116,14 @@ class ExtendedKalmanFilter(Estimator):
         return None if self.R_of_reading is None else self.R_of_reading(y)
 
     def correct(self, x, P, H, innovation, state, R=None):
-        """Joseph-form Kalman update (:func:`~hinfnav.estimators.correction.joseph_update`).
+        """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
 
         Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
         (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
-        on the reading or on the missing channels (default the constant
-        :attr:`R`). Diagnostics: ``innovation_covariance`` S (runs, m, m).
+        on the reading or on the missing channels (default the constant :attr:`R`).
         """
-        R = self.R if R is None else R
-        dx, P_post, S = joseph_update(P, H, R, innovation, symmetrize=False)
-        runs = x.shape[0]
-        return x + dx, P_post, {"innovation_covariance": S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape)}
+        dx, P_post, diag = self.correct_error(P, H, self.R if R is None else R, innovation)
+        return x + dx, P_post, diag
 
     # -- the step contract --------------------------------------------------------
 
