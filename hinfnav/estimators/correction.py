@@ -76,10 +76,10 @@ def kalman_gain(P, H, R, *, symmetrize=True):
     """
     HT = _swap(H)
     PHT = matmul_shared(P, HT)
-    if PHT.ndim == 2 or H.ndim == 3:
+    if PHT.ndim == 2 or not symmetrize:
         S = H @ PHT + R
-    else:
-        S = matmul_shared(_swap(PHT), HT) + R  # H P Hᵀ (P symmetric)
+    else:  # H P Hᵀ = (P Hᵀ)ᵀ Hᵀ (P symmetric): the order of the sums of the augmented core, whose numbers it keeps
+        S = matmul_shared(_swap(PHT), HT) + R
     K = PHT @ inv_spd(S)
     I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
     P_post = I_KH @ P @ _swap(I_KH) + matmul_shared(K, R) @ _swap(K)
