@@ -45,6 +45,7 @@ from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput, available_channels
 from .correction import drop_missing, kalman_gain
+from .steady import CHECK_EVERY, freeze_gain
 from .kalman import ExtendedKalmanFilter
 
 __all__ = ["ExtendedStateKalmanFilter", "SaturatedExtendedStateFilter", "FusedExtendedStateFilter",
@@ -63,20 +64,6 @@ def theta_star(Q1, P0):
         raise InputError(f"theta* = sqrt(tr Q1 / tr P0) needs tr Q1 > 0 and tr P0 > 0; got {num:.3g}, {den:.3g}: "
                          "give theta explicitly")
     return float(np.sqrt(num / den))
-
-
-#: The convergence of P⁻ is checked every CHECK_EVERY steps (against P⁻ of CHECK_EVERY steps before).
-CHECK_EVERY = 64
-
-
-def _converged(new, old, tol):
-    """Largest change of P⁻ since the last check, each entry relative to √(P_ii P_jj), at most ``tol`` per step."""
-    if tol is None or old is None or np.shape(new) != np.shape(old):
-        return False
-    tol = tol * CHECK_EVERY
-    d = np.sqrt(np.abs(np.diagonal(new, axis1=-2, axis2=-1)))
-    scale = d[..., :, None] * d[..., None, :]
-    return bool(np.all(np.abs(new - old) <= tol * scale))
 
 
 def _check_tol(steady_tol):
@@ -202,10 +189,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             P = steady["P_prior"]
         else:
             P = self.predict_covariance(state.P, state)
-            if self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-                if _converged(P, state.extra.get("check_prior"), self.steady_tol):
-                    steady = {"P_prior": P}
-                extra["check_prior"] = P
+            steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
         extra["steady"] = steady
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
@@ -457,10 +441,8 @@ class SaturatedExtendedStateFilter(Estimator):
         extra = dict(state.extra, u_feed=np.zeros_like(u))
         if steady is not None:
             P = steady["P_prior"]
-        elif self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-            if _converged(P, state.extra.get("check_prior"), self.steady_tol):
-                steady = {"P_prior": P}
-            extra["check_prior"] = P
+        else:
+            steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
         extra["steady"] = steady
         return FilterState(x=X, P=P, k=state.k + 1, extra=extra)
 
@@ -641,10 +623,6 @@ class FusedExtendedStateFilter(Estimator):
         else:
             P1 = a1.predict_covariance(state.P, state)
             X2, P2 = self.alg2.kernel_predict(state.extra["X2"], state.extra["P2"], u2)
-            if self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-                if _converged(P1, state.extra.get("check_P1"), self.steady_tol) and _converged(
-                        P2, state.extra.get("check_P2"), self.steady_tol):
-                    steady = {"P1_prior": P1, "P2_prior": P2}
-                extra.update(check_P1=P1, check_P2=P2)
+            steady = freeze_gain(self.steady_tol, state.k, extra, P1_prior=P1, P2_prior=P2)
         extra.update(X2=X2, P2=P2, steady=steady)
         return FilterState(x=x1, P=P1, k=state.k + 1, extra=extra)

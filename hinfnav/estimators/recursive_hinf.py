@@ -39,7 +39,7 @@ from ..analysis.hinf_riccati import max_admissible_theta
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
+from .base import Estimator, FilterState, StepOutput
 
 __all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
 
@@ -208,53 +208,3 @@ class RecursiveHInfinityFilter(Estimator):
             x = x + np.asarray(u, dtype=float) @ self.Gamma.T
         extra = {"steady": state.extra.get("steady")}
         return FilterState(x=x, P=state.extra["P_next"], k=state.k + 1, extra=extra)
-
-    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
-        """Batch path: the (data-independent) gain sequence once, then all runs at once; same numbers as the steps."""
-        keys = history_keys(keep_covariance, diagnostics)
-        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None, self.missing)
-        diagnostics = keys is None or bool(keys)
-        runs, n1, _ = y.shape
-        state = self.start(xhat0, P0, runs)
-        P, steady = state.P, None
-        P_hist = np.empty((n1,) + P.shape) if keep_covariance else None
-        margins, oks, FKs = np.empty(n1), np.empty(n1, dtype=bool), []
-        for k in range(n1):
-            if keep_covariance:
-                P_hist[k] = P
-            K, P, margins[k], oks[k], steady = self._gain(P, k, steady)
-            FKs.append(self.F @ K)
-            if steady is not None:  # the gain no longer changes: P_j = P_k for j > k
-                if keep_covariance:
-                    P_hist[k + 1:] = P
-                margins[k + 1:], oks[k + 1:] = margins[k], oks[k]
-                break
-        xhat = np.empty((runs, n1, self.n_state))
-        innov = np.empty(y.shape) if diagnostics else None
-        x = state.x
-        Ft, Ht, Gt = self.F.T, self.H.T, self.Gamma.T
-        for k in range(n1):
-            xhat[:, k] = x
-            e = y[:, k] - x @ Ht
-            if self.missing == "skip":
-                e = np.where(np.isnan(e), 0.0, e)
-            if diagnostics:
-                innov[:, k] = e
-            if k < n1 - 1:
-                FK = FKs[min(k, len(FKs) - 1)]
-                x = x @ Ft + e @ FK.T
-                if self.uses_input:
-                    x = x + u[:, k] @ Gt
-        out_P = None
-        if keep_covariance:
-            P_hist.setflags(write=False)
-            out_P = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
-            if keep_covariance == "diagonal":
-                out_P = np.diagonal(out_P, axis1=-2, axis2=-1)
-        diag = {}
-        if diagnostics:
-            diag = {"innovation": innov, "existence_margin": np.broadcast_to(margins, (runs, n1)).copy(),
-                    "existence_ok": np.broadcast_to(oks, (runs, n1)).copy()}
-            diag = {key: val for key, val in diag.items() if keys is None or key in keys}
-        return EstimateHistory(xhat=xhat, P=out_P, state=self.system.state, diagnostics=diag)
