@@ -325,6 +325,12 @@ class Estimator:
                              "inf entries")
         return u
 
+    def _check_feed_input(self, state, u):
+        """The input a reading contains (``feed_input`` of a filter whose readings hold ``D u``): checked as
+        ``predict`` checks u, between ``start``/``predict`` and ``update``."""
+        self._check_order(state, "feed_input", "prior")
+        return self._check_step_input(state, u, "feed_input")
+
     @staticmethod
     def _phase(new, old, phase):
         """``new`` marked with ``phase`` (a copy when a hook handed back the state it was given)."""

@@ -27,11 +27,8 @@ the filter the input held when the reading was taken with ``feed_input``
 before ``update``; without it the reading is taken to exclude the input part.
 
 Every filter can freeze its gains once the covariance recursion has
-converged (``steady_tol``: largest change of P⁻ per step, each entry relative
-to √(P_ii P_jj), checked over blocks of ``CHECK_EVERY`` steps; ``None``, the
-default, never freezes); for a state without process noise the recursion
-converges at the rate θ per step, so its gains are then within about
-``steady_tol/θ`` of their limit. A clipped reading unfreezes Algorithms 2, 3.
+converged (``steady_tol``, :func:`hinfnav.estimators.steady.freeze_gain`;
+``None``, the default, never freezes). A clipped reading unfreezes Algorithms 2, 3.
 """
 
 import numpy as np
@@ -178,8 +175,6 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
 
     def _predict(self, state, u):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = self.predict_mean(state.x, np.asarray(u, dtype=float))
         if self.nominal is not None:
             x = x + _increment(self.nominal, state.k, self._q_sqrt) @ self.B_e.T
@@ -192,12 +187,6 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
         extra["steady"] = steady
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
-
-
-def _check_feed(self, state, u):
-    """The input a reading contains (``feed_input``): checked as ``predict`` checks u, before an ``update``."""
-    self._check_order(state, "feed_input", "prior")
-    return self._check_step_input(state, u, "feed_input")
 
 
 def _axis_arrays(name, value, shape):
@@ -244,7 +233,6 @@ class SaturatedExtendedStateFilter(Estimator):
 
     name = "saturated_eskf"
     uses_input = True
-    _check_feed = _check_feed
 
     def __init__(self, A_d, B_d, C, D, *, R, S, q, P0, lower, upper, dt, mode="truncated", state=None,
                  measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None,
@@ -402,7 +390,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     def feed_input(self, state, u):
         """The state with the input ``u_k`` (runs, n_axes) that the next reading contains through ``D u_k``."""
-        u = self._check_feed(state, u)
+        u = self._check_feed_input(state, u)
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u), phase=state.phase)
 
     def from_full_cov(self, P0):
@@ -433,8 +421,6 @@ class SaturatedExtendedStateFilter(Estimator):
         return new, StepOutput(xhat=self.to_full(X), P=self.full_covariance(P), diagnostics=diag)
 
     def _predict(self, state, u):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         u = np.asarray(u, dtype=float)
         steady = state.extra.get("steady")
         X, P = self.kernel_predict(state.x, None if steady is not None else state.P, u)
@@ -471,7 +457,6 @@ class FusedExtendedStateFilter(Estimator):
 
     name = "fused_eskf"
     uses_input = True
-    _check_feed = _check_feed
 
     def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None,
                  missing="refuse"):
@@ -532,58 +517,46 @@ class FusedExtendedStateFilter(Estimator):
 
     def feed_input(self, state, u):
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
-        u = self._check_feed(state, u)
+        u = self._check_feed_input(state, u)
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
                            phase=state.phase)
 
     def _update(self, state, y):
-        y = np.asarray(y, dtype=float)
-        x1, P1 = state.x, state.P
+        x1, P1, X2, P2 = state.x, state.P, state.extra["X2"], state.extra["P2"]
         steady = state.extra["steady"]
-        a1 = self.alg1
-        innov1 = y[:, : self._m1] - x1 @ a1.measurement.H.T
+        a1, m1 = self.alg1, self._m1
+        innov1 = y[:, :m1] - x1 @ a1.measurement.H.T
         miss = np.isnan(y) if self.missing == "skip" else None
+        if miss is not None and not miss.any():
+            miss = None
         if miss is not None and miss.all():  # no reading at all: the prediction is the estimate (no fusion either)
-            runs = x1.shape[0]
-            th1, th2 = self._thetas(runs)
-            diag = {"innovation": np.full(y.shape, np.nan), "saturated": np.zeros((runs, self.alg2.n_axes), dtype=bool),
-                    "theta": th1, "theta_alg2": th2}
-            return (FilterState(x=x1, P=P1, k=state.k, extra=dict(state.extra)),
-                    StepOutput(xhat=x1, P=P1, diagnostics=diag))
-        if miss is not None and miss.any():  # this step's gains, without the missing channels (exact)
-            X2, P2, innov2, sat, _ = self.alg2.kernel_update(state.extra["X2"], state.extra["P2"], y[:, self._m1:],
-                                                             state.extra["u_feed"], missing=miss[:, self._m1:])
-            sat = sat & ~miss[:, self._m1:]
-            P1m, H1, R1, used = drop_missing(P1, a1.measurement.H, a1.R, innov1, ~miss[:, : self._m1])
+            innov2, sat = np.full((y.shape[0], y.shape[1] - m1), np.nan), np.zeros(X2.shape[:2], dtype=bool)
+        elif miss is not None:  # this step's gains without the missing channels (exact); the frozen gains kept aside
+            X2, P2, innov2, sat, _ = self.alg2.kernel_update(X2, P2, y[:, m1:], state.extra["u_feed"],
+                                                             missing=miss[:, m1:])
+            sat, innov2 = sat & ~miss[:, m1:], np.where(miss[:, m1:], np.nan, innov2)
+            P1m, H1, R1, used = drop_missing(P1, a1.measurement.H, a1.R, innov1, ~miss[:, :m1])
             K1, P1p = a1.gain(P1m, H1, R1)
             x1 = x1 + (K1 @ used[..., None])[..., 0] if K1.ndim == 3 else x1 + used @ K1.T
             x1, P1, X2, P2 = self.fuse(x1, np.broadcast_to(P1p, P1.shape), X2, P2)
-            innov2 = np.where(miss[:, self._m1:], np.nan, innov2)
             if steady is not None:
-                steady = None if sat.any() else {key: v for key, v in steady.items()
-                                                 if key not in ("K1", "K2", "P1_post", "P2_post")}
-            runs = x1.shape[0]
-            th1, th2 = self._thetas(runs)
-            diag = {"innovation": np.concatenate([innov1, innov2], axis=1), "saturated": sat, "theta": th1,
-                    "theta_alg2": th2}
-            extra = dict(state.extra, X2=X2, P2=P2, steady=steady)
-            return FilterState(x=x1, P=P1, k=state.k, extra=extra), StepOutput(xhat=x1, P=P1, diagnostics=diag)
-        cache2 = None if steady is None or "K2" not in steady else (steady["K2"], steady["P2_post"])
-        X2, P2, innov2, sat, K2 = self.alg2.kernel_update(state.extra["X2"], state.extra["P2"], y[:, self._m1:],
-                                                          state.extra["u_feed"], cache2)
-        if cache2 is not None and not sat.any():
-            K1 = steady["K1"]
-            x1 = x1 + (K1 @ innov1[..., None])[..., 0]
-            x1, X2 = self._fuse_mean(x1, X2)
-            P1, P2 = steady["P1_post"], steady["P2_post"]
+                steady = None if sat.any() else {k: v for k, v in steady.items() if not k.endswith("post")
+                                                 and k not in ("K1", "K2")}
         else:
-            K1, P1p = a1.gain(P1)
-            x1 = x1 + (K1 @ innov1[..., None])[..., 0]
-            x1, P1, X2, P2 = self.fuse(x1, P1p, X2, P2)
-            if steady is not None:
-                steady = None if sat.any() else dict(steady, K1=K1, K2=K2, P1_post=P1, P2_post=P2)
-        runs = x1.shape[0]
-        th1, th2 = self._thetas(runs)
+            cache2 = None if steady is None or "K2" not in steady else (steady["K2"], steady["P2_post"])
+            X2, P2, innov2, sat, K2 = self.alg2.kernel_update(X2, P2, y[:, m1:], state.extra["u_feed"], cache2)
+            if cache2 is not None and not sat.any():
+                K1 = steady["K1"]
+                x1 = x1 + (K1 @ innov1[..., None])[..., 0]
+                x1, X2 = self._fuse_mean(x1, X2)
+                P1, P2 = steady["P1_post"], steady["P2_post"]
+            else:
+                K1, P1p = a1.gain(P1)
+                x1 = x1 + (K1 @ innov1[..., None])[..., 0]
+                x1, P1, X2, P2 = self.fuse(x1, P1p, X2, P2)
+                if steady is not None:
+                    steady = None if sat.any() else dict(steady, K1=K1, K2=K2, P1_post=P1, P2_post=P2)
+        th1, th2 = self._thetas(x1.shape[0])
         diag = {"innovation": np.concatenate([innov1, innov2], axis=1), "saturated": sat, "theta": th1,
                 "theta_alg2": th2}
         extra = dict(state.extra, X2=X2, P2=P2, steady=steady)
@@ -607,8 +580,6 @@ class FusedExtendedStateFilter(Estimator):
         return x1, Xo
 
     def _predict(self, state, u):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         u = np.asarray(u, dtype=float)
         a1 = self.alg1
         x1 = a1.predict_mean(state.x, u)
