@@ -13,12 +13,20 @@ row falls below 1 (ψ = γ/|ζ| < 1 by definition).
 
 import numpy as np
 import pytest
+from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
 from test_missing_readings import P0, SYSTEM, X0, measurement, small_data
 
-from hinfnav.estimators import AugmentedInputHuberSTKF, AugmentedInputSTKF, joseph_update, kalman_gain
+from hinfnav.estimators import (
+    AugmentedInputHuberSTKF,
+    AugmentedInputSTKF,
+    ExtendedKalmanFilter,
+    joseph_update,
+    kalman_gain,
+)
 from hinfnav.estimators.attitude import AttitudeAEKF, AttitudeASTEKF, AttitudeHuberEKF, AttitudeHuberSTEKF
 from hinfnav.papers.attitude2018 import Scenario
 from hinfnav.sim.nonlinear import simulate_nonlinear_truth
+from hinfnav.systems import LinearMeasurement, StateSpec
 
 BIG = 1e9  # a Huber threshold no whitened residual reaches: every weight is 1
 
@@ -105,3 +113,76 @@ def test_one_kalman_correction_gives_the_gain_and_the_update():
     np.testing.assert_allclose(P_post, P - K @ H @ P, rtol=1e-14)  # Joseph = short form at the optimal gain
     dx, _, _ = joseph_update(P, H, R, np.array([[1.0], [2.0]]))
     np.testing.assert_allclose(dx, [[0.8, 0.2], [1.6, 0.4]], rtol=1e-15)
+
+
+# --- the EKF on a nonlinear dynamics model (the dynamics-model protocol) -----------------------
+
+
+class ConstantTurn:
+    """A tiny dynamics model (protocol of issue 17): constant turn with unknown rate ω, x = [x, y, vx, vy, ω]."""
+
+    n, n_input, dt, linear = 5, 0, 1.0, False
+    state = StateSpec(labels=["x", "y", "vx", "vy", "w"], units=["m", "m", "m/s", "m/s", "rad/s"])
+    Q = np.diag([0.01, 0.01, 0.01, 0.01, 1e-6])
+
+    def f(self, x, u=None, t=0.0):
+        px, py, vx, vy, w = np.moveaxis(x, -1, 0)
+        s, c = np.sin(w * self.dt), np.cos(w * self.dt)
+        return np.stack([px + (s * vx - (1 - c) * vy) / w, py + ((1 - c) * vx + s * vy) / w,
+                         c * vx - s * vy, s * vx + c * vy, w], axis=-1)
+
+    def jacobian(self, x, u=None, t=0.0):
+        """∂f/∂x, analytic, (runs, 5, 5)."""
+        x = np.atleast_2d(x)
+        vx, vy, w, T = x[:, 2], x[:, 3], x[:, 4], self.dt
+        s, c = np.sin(w * T), np.cos(w * T)
+        J = np.zeros(x.shape[:1] + (5, 5))
+        J[:, 0, 0] = J[:, 1, 1] = J[:, 4, 4] = 1.0
+        J[:, 0, 2], J[:, 0, 3] = s / w, -(1 - c) / w
+        J[:, 0, 4] = T * (c * vx - s * vy) / w - (s * vx - (1 - c) * vy) / w**2
+        J[:, 1, 2], J[:, 1, 3] = (1 - c) / w, s / w
+        J[:, 1, 4] = T * (s * vx + c * vy) / w - ((1 - c) * vx + s * vy) / w**2
+        J[:, 2, 2], J[:, 2, 3], J[:, 2, 4] = c, -s, -T * (s * vx + c * vy)
+        J[:, 3, 2], J[:, 3, 3], J[:, 3, 4] = s, c, T * (c * vx - s * vy)
+        return J
+
+
+def test_ekf_on_a_nonlinear_dynamics_model_equals_filterpy():
+    model = ConstantTurn()
+    meas = LinearMeasurement(np.eye(2, 5), 3.0 * np.eye(2))
+    rng = np.random.default_rng(4)
+    x = np.array([[0.0, 0.0, 10.0, 0.0, 0.05]])
+    xs, ys = [], []
+    for _ in range(60):
+        xs.append(x[0])
+        ys.append(x[0, :2] + 3.0 * rng.standard_normal(2))
+        x = model.f(x)
+    y = np.array(ys)[None]
+    x0, P0m = np.array([1.0, -1.0, 9.0, 0.5, 0.03]), np.diag([25.0, 25.0, 4.0, 4.0, 1e-3])
+    hist = ExtendedKalmanFilter(model, meas, P0=P0m).estimate(y, np.zeros((1, 60, 0)), x0)
+
+    class CT(FilterpyEKF):
+        def predict_x(self, u=0):
+            self.x = model.f(self.x[None])[0]
+
+    f = CT(dim_x=5, dim_z=2)
+    f.x, f.P, f.Q, f.R = x0.copy(), P0m.copy(), model.Q, meas.R
+    ref = []
+    for k in range(60):
+        f.update(y[0, k], lambda s: meas.H, lambda s: meas.H @ s)
+        ref.append(f.x.copy())
+        f.F = model.jacobian(f.x)[0]  # at x̂(k|k), before the mean moves on
+        f.predict()
+    # expected: filterpy's EKF step for step (same f, same Jacobian); 1e-10 relative
+    np.testing.assert_allclose(hist.xhat[0], np.array(ref), rtol=1e-10, atol=1e-10)
+    assert np.abs(hist.xhat[0, -1, :2] - xs[-1][:2]).max() < 10.0  # it tracks the turn
+
+
+def test_constant_turn_jacobian_matches_central_differences():
+    # expected: central differences of f (truncation O(h²) ≈ 1e-10 with h = 1e-5, rounding ≈ 1e-11)
+    model, x = ConstantTurn(), np.array([[3.0, -2.0, 10.0, 4.0, 0.07]])
+    J = model.jacobian(x)[0]
+    for j in range(5):
+        e = np.zeros(5)
+        e[j] = 1e-5
+        np.testing.assert_allclose(J[:, j], (model.f(x + e) - model.f(x - e))[0] / 2e-5, rtol=1e-6, atol=1e-8)

@@ -1,7 +1,9 @@
 """Kalman filters on the step contract: the linear/extended Kalman filter, batched over runs.
 
 :class:`ExtendedKalmanFilter` propagates a linear system (its Jacobian is Φ)
-and linearizes the measurement model at the prior estimate. It is one
+or any dynamics model (``n``, ``n_input``, ``dt``, ``state``, ``Q``,
+``linear`` False, ``f(x, u, t)`` and ``jacobian(x, u, t)``: the Jacobian at
+x̂(k|k) propagates P) and linearizes the measurement model at the prior estimate. It is one
 class with small hooks that the variants override:
 
 * :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``
@@ -85,27 +87,40 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
         self.uses_input = bool(uses_input)
         self.output = as_choice("output", output, OUTPUTS)
-        self.F = system.Phi
-        self.Gamma = system.Gamma
-        self._I = np.eye(n)
+        #: the dynamics model's f(x, u, t) and Jacobian propagate when the system says it is not linear
+        self.nonlinear_dynamics = not getattr(system, "linear", True)
+        if self.nonlinear_dynamics:
+            if not (callable(getattr(system, "f", None)) and callable(getattr(system, "jacobian", None))):
+                raise InputError(f"system {type(system).__name__} says it is not linear but has no f(x, u, t) and "
+                                 "jacobian(x, u, t)")
+        elif getattr(system, "Phi", None) is None:
+            raise InputError(f"system must be a LinearSystem (with Phi) or a dynamics model (f, jacobian); got "
+                             f"{type(system).__name__}")
+        self.F = getattr(system, "Phi", None)
+        self.Gamma = getattr(system, "Gamma", None)
 
     @property
     def shares_covariance(self):
         """True when P and the gain do not depend on the data (linear measurement, constant R)."""
-        return bool(self.measurement.linear) and self.R_of_reading is None
+        return bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
 
     # -- hooks ------------------------------------------------------------------
 
-    def predict_mean(self, x, u):
-        """``Φ x̂ (+ Γ u)`` for a batch of estimates."""
+    def predict_mean(self, x, u, t=0.0):
+        """``Φ x̂ (+ Γ u)`` for a batch of estimates, or the dynamics model's ``f(x̂, u, t)`` (t the time of x̂, s)."""
+        if self.nonlinear_dynamics:
+            return self.system.f(x, u if self.uses_input else None, t)
         out = x @ self.F.T
         if self.uses_input:
             out = out + u @ self.Gamma.T
         return out
 
-    def predict_covariance(self, P, state):
-        """``Φ P Φᵀ + Q`` (P shared (n, n) or per run (runs, n, n))."""
-        return congruence(self.F, P) + self.Q
+    def predict_covariance(self, P, state, F=None):
+        """``F P Fᵀ + Q`` with F = Φ, or the dynamics model's Jacobian at x̂(k|k) ((n, n) or (runs, n, n))."""
+        F = self.F if F is None else F
+        if F.ndim == 3:
+            return F @ P @ np.swapaxes(F, -1, -2) + self.Q
+        return congruence(F, P) + self.Q
 
     def measurement_covariance(self, y, x):
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
@@ -165,8 +180,14 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        x = self.predict_mean(state.x, u)
-        P = self.predict_covariance(state.P, state)
+        if self.nonlinear_dynamics:  # the Jacobian at the posterior x̂(k|k), before the mean moves on
+            t = state.k * self.dt
+            F = np.asarray(self.system.jacobian(state.x, u if self.uses_input else None, t), dtype=float)
+            P = self.predict_covariance(state.P, state, F=F)
+            x = self.predict_mean(state.x, u, t)
+        else:
+            x = self.predict_mean(state.x, u)
+            P = self.predict_covariance(state.P, state)
         extra = {key: val for key, val in state.extra.items() if key != "prior"}
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
