@@ -58,7 +58,7 @@ class AttitudeAEKF(AugmentedEKF):
 
     name = "aekf"
 
-    def __init__(self, system, measurement, *, P0, Q, R=None, output="filtered", name=None):
+    def __init__(self, system, measurement, *, P0, Q, R=None, output="filtered", name=None, missing="refuse"):
         if not isinstance(system, AttitudeSystem):
             raise InputError(f"system must be a hinfnav AttitudeSystem; got {type(system).__name__}")
         if system.disturbance is not None:
@@ -69,7 +69,7 @@ class AttitudeAEKF(AugmentedEKF):
         if Q.ndim == 0:
             Q = float(Q) * np.eye(3)
         super().__init__(system, measurement, n_cov=9, aug_input=AttitudeSystem.noise_input(), P0=P0, Q=Q, R=R,
-                         uses_input=True, output=output, name=name)
+                         uses_input=True, output=output, name=name, missing=missing)
 
     def initial_internal(self, xhat0):
         x = xhat0.copy()

@@ -67,6 +67,9 @@ class AugmentedEKF(KalmanCorrection, Estimator):
     uses_input : bool
     output : {"filtered", "predicted"}
     name : str
+    missing : {"refuse", "skip"}
+        A NaN channel: an InputError, or removed exactly at that step
+        (:func:`~hinfnav.estimators.correction.drop_missing`).
     """
 
     name = "augmented ekf"
@@ -74,8 +77,8 @@ class AugmentedEKF(KalmanCorrection, Estimator):
     linear_model = False
 
     def __init__(self, system, measurement, *, n_cov, aug_input, P0, Q, base_noise=None, R=None, uses_input=False,
-                 output="filtered", name=None):
-        super().__init__(system, measurement, name=name)
+                 output="filtered", name=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         self.n_cov = int(n_cov)
         self.E = np.asarray(aug_input, dtype=float)
         if self.E.ndim != 2 or self.E.shape[0] != self.n_cov:
@@ -273,7 +276,8 @@ class AugmentedInputKF(AugmentedEKF):
 
     name = "augmented input kf"
 
-    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None):
+    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None,
+                 missing="refuse"):
         for attr in ("Phi", "Gamma"):
             if not hasattr(system, attr):
                 raise InputError(f"system must be a hinfnav LinearSystem (with Phi, Gamma); got {type(system).__name__}")
@@ -289,7 +293,7 @@ class AugmentedInputKF(AugmentedEKF):
         base[:n, :n] = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
         E = np.vstack([np.zeros((n, m)), np.eye(m)])
         super().__init__(system, measurement, n_cov=n + m, aug_input=E, P0=P0, Q=Q_input, base_noise=base, R=R,
-                         uses_input=False, output=output, name=name)
+                         uses_input=False, output=output, name=name, missing=missing)
         self.Phi_a = np.block([[system.Phi, system.Gamma], [np.zeros((m, n)), np.eye(m)]])
         self._n = n
         self.linear_model = bool(measurement.linear)

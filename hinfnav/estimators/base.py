@@ -23,6 +23,15 @@ input u_k held over [t_k, t_{k+1}) (ignored unless ``uses_input``).
 loops over the steps with all runs at once; a subclass may override it with a
 faster path that gives the same numbers (tested by the contract suite).
 
+The public ``start``/``update``/``predict`` trust nothing: they check the call
+order (``FilterState.phase``), the shapes and finiteness of ``xhat0``, ``P0``,
+y and u, and name the parameter and the step in an
+:class:`~hinfnav.core.exceptions.InputError`; then they call the hooks
+``_start``/``_update``/``_predict`` that each estimator implements. The batch
+``estimate`` checks its arrays once and calls the hooks directly.
+``missing="skip"`` (a constructor option of every filter, or the
+:attr:`Estimator.missing` property) lets a NaN channel mark a missing reading.
+
 Variants override one hook: the Huber filter the correction, a strong-tracking
 filter the covariance prediction, an augmented filter the system it is built
 on, a saturated-measurement filter the update when a channel is clipped.

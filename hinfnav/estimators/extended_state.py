@@ -103,7 +103,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
     name = "eskf"
 
     def __init__(self, system, measurement, *, P0, B_e, q, S=None, R=None, theta=None, nominal=None, steady_tol=None,
-                 name=None):
+                 name=None, missing="refuse"):
         n = system.n
         self.B_e = as_matrix("B_e", B_e, (n, None))
         self.q = as_vector("q", q, self.B_e.shape[1])
@@ -119,7 +119,8 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         P0c = as_covariance("P0", P0, n, definite=True)
         self.theta = theta_star(self.Q1, P0c) if theta is None else as_positive("theta", theta)
         Q = (1.0 + 1.0 / self.theta) * self.Q1 + self.Q2
-        super().__init__(system, measurement, P0=P0c, Q=0.5 * (Q + Q.T), R=R, uses_input=True, name=name)
+        super().__init__(system, measurement, P0=P0c, Q=0.5 * (Q + Q.T), R=R, uses_input=True, name=name,
+                         missing=missing)
         if nominal is not None and not callable(nominal):
             raise InputError("nominal must be a callable k -> f_bar_k")
         self.nominal = nominal

@@ -46,7 +46,7 @@ class HuberCorrection:
     tracking, the attitude filters). Keyword parameters ``gamma``, ``tol``,
     ``max_iter`` as in :class:`HuberFilter`. The weights make P depend on the
     data: every run carries its own covariance. Diagnostics: ``weights``,
-    ``iterations``, ``converged``.
+    ``iterations``, ``converged``, ``innovation_covariance`` (H P⁻ Hᵀ + R).
     """
 
     data_dependent_covariance = True
@@ -70,7 +70,10 @@ class HuberCorrection:
         dx, P_post, weights, iterations, converged = huber_correct(
             None, P, innovation, H, R, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
             LRi=self._LRi if R is self.R else None)
-        return dx, P_post, {"weights": weights, "iterations": iterations, "converged": converged}
+        HT = np.swapaxes(H, -1, -2)
+        S = H @ P @ HT + R  # innovation covariance of the prior (the Kalman start of the regression)
+        return dx, P_post, {"weights": weights, "iterations": iterations, "converged": converged,
+                            "innovation_covariance": S}
 
 
 class HuberFilter(HuberCorrection, ExtendedKalmanFilter):
