@@ -41,7 +41,7 @@ from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.systems import LinearMeasurement, LinearSystem, StateSpec
 
 RUNS, STEPS = 3, 40
-TOL = dict(rtol=1e-10, atol=1e-9)
+TOL = {"rtol": 1e-10, "atol": 1e-9}
 
 # --- a small linear problem: 2-D constant velocity, three position readings ------------------
 
