@@ -222,7 +222,8 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         x_post = self.inject(x, dx)
         extra.update(self.after_update(state, x_post))
         runs = x.shape[0]
-        diag.update(d_corr, innovation=innovation, input_estimate=self.augmented(x_post))
+        diag.update(d_corr, innovation=innovation if mask is None else np.where(mask, innovation, np.nan),
+                    input_estimate=self.augmented(x_post))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         if self.output == "filtered":
             return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
