@@ -366,8 +366,9 @@ def test_bad_estimate_arguments(short_scenario):
         ekf.estimate(y, u, np.zeros(5))
     with pytest.raises(InputError, match="y must have shape"):
         ekf.estimate(np.zeros((n1, 3)), u, sc.xhat0)
-    with pytest.raises(InputError, match="predict needs u"):
-        build_ekf(sc, known_input=True).predict(ekf.start(sc.xhat0))
+    known = build_ekf(sc, known_input=True)
+    with pytest.raises(InputError, match="predict at step 0 needs u"):
+        known.predict(known.update(known.start(sc.xhat0), y[:, 0])[0])
 
 
 def test_bad_range_angle_arguments():

@@ -7,9 +7,10 @@ matrices.
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
 from .huber import HuberUpdate, huber_update
 from .adaptive import RateAdaptive, StrongTracking
-from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputKF, AugmentedInputSTKF
+from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
 from .extended_state import ExtendedStateKalmanFilter, FusedExtendedStateFilter, SaturatedExtendedStateFilter
-from .huber_filter import HuberFilter
+from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
+from .huber_filter import HuberCorrection, HuberFilter
 from .recursive_hinf import RecursiveHInfinityFilter
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 from .lti import LTIFilter
@@ -28,6 +29,12 @@ __all__ = [
     "huber_update",
     "HuberUpdate",
     "HuberFilter",
+    "HuberCorrection",
+    "KalmanCorrection",
+    "joseph_update",
+    "kalman_gain",
+    "drop_missing",
+    "AugmentedInputHuberSTKF",
     "ExtendedStateKalmanFilter",
     "SaturatedExtendedStateFilter",
     "FusedExtendedStateFilter",

@@ -191,11 +191,27 @@ class StrongTracking:
             raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
         self.a = a
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
-        V0 = innovation_moment(state.extra.get("V0"), innovation, self.rho)
-        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, self.R, beta=self.beta, a=self.a)
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """(S1)-(S4). With missing channels (``~mask``; innovation and H zero there) the moment and N use the
+        channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
+        V0_old = state.extra.get("V0")
+        V0 = innovation_moment(V0_old, innovation, self.rho)
+        R, keep = self.R, {}
+        if mask is not None or "V0_started" in state.extra:  # some run has skipped a whole reading
+            runs = innovation.shape[0]
+            gone = np.zeros(runs, dtype=bool) if mask is None else ~mask.any(axis=1)
+            started = state.extra.get("V0_started", np.full(runs, V0_old is not None))
+            fresh = innovation_moment(None, innovation, self.rho)
+            if V0_old is not None:  # (S1) from γγᵀ in the runs without a moment yet; unchanged in the skipped ones
+                V0 = np.where(gone[:, None, None], V0_old, np.where(started[:, None, None], V0, fresh))
+            keep = {"V0_started": started | ~gone}
+        if mask is not None:
+            R = np.where(mask[:, :, None] & mask[:, None, :], R, 0.0)
+        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, R, beta=self.beta, a=self.a)
+        if mask is not None:
+            lam = np.where(gone[:, None], 1.0, lam)
         P = fade(PhiPPhiT, lam) + Qd
-        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, {"V0": V0}
+        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
 
     def initial_diagnostics(self, runs):
         out = super().initial_diagnostics(runs)
@@ -236,8 +252,8 @@ class RateAdaptive:
         Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
         return Qd, {"q_used": q, "kappa_used": kappa}
 
-    def start(self, xhat0, P0=None, runs=1):
-        state = super().start(xhat0, P0, runs)
+    def _start(self, xhat0, P0, runs):
+        state = super()._start(xhat0, P0, runs)
         window = np.zeros((self.window + 1, runs, self.n_aug))
         state.extra.update(rate_window=window, rate_count=0)
         return state

@@ -31,8 +31,9 @@ from ..core.exceptions import InputError
 from ..systems.attitude import TORQUE, AttitudeSystem, StarSensorVectors
 from .adaptive import RateAdaptive, StrongTracking
 from .augmented import AugmentedEKF
+from .huber_filter import HuberCorrection
 
-__all__ = ["AttitudeAAEKF", "AttitudeAEKF", "AttitudeASTEKF"]
+__all__ = ["AttitudeAAEKF", "AttitudeAEKF", "AttitudeASTEKF", "AttitudeHuberEKF", "AttitudeHuberSTEKF"]
 
 
 class AttitudeAEKF(AugmentedEKF):
@@ -57,7 +58,7 @@ class AttitudeAEKF(AugmentedEKF):
 
     name = "aekf"
 
-    def __init__(self, system, measurement, *, P0, Q, R=None, output="filtered", name=None):
+    def __init__(self, system, measurement, *, P0, Q, R=None, output="filtered", name=None, missing="refuse"):
         if not isinstance(system, AttitudeSystem):
             raise InputError(f"system must be a hinfnav AttitudeSystem; got {type(system).__name__}")
         if system.disturbance is not None:
@@ -68,7 +69,7 @@ class AttitudeAEKF(AugmentedEKF):
         if Q.ndim == 0:
             Q = float(Q) * np.eye(3)
         super().__init__(system, measurement, n_cov=9, aug_input=AttitudeSystem.noise_input(), P0=P0, Q=Q, R=R,
-                         uses_input=True, output=output, name=name)
+                         uses_input=True, output=output, name=name, missing=missing)
 
     def initial_internal(self, xhat0):
         x = xhat0.copy()
@@ -116,3 +117,21 @@ class AttitudeAAEKF(RateAdaptive, AttitudeAEKF):
     """
 
     name = "aaekf"
+
+
+class AttitudeHuberEKF(HuberCorrection, AttitudeAEKF):
+    """:class:`AttitudeAEKF` whose correction is Huber's M-estimation (Karlgaard & Schaub 2007).
+
+    Extra parameters ``gamma``, ``tol``, ``max_iter``; see
+    :class:`~hinfnav.estimators.huber_filter.HuberCorrection`. The regression
+    is solved for the 9 error coordinates and injected as the AEKF's
+    correction (multiplicative for the quaternion).
+    """
+
+    name = "huber_aekf"
+
+
+class AttitudeHuberSTEKF(HuberCorrection, StrongTracking, AttitudeAEKF):
+    """Huber correction with strong tracking on the attitude filter (both mixins on :class:`AttitudeAEKF`)."""
+
+    name = "huber_astekf"

@@ -28,38 +28,22 @@ its covariance is shared by every run.
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance, congruence, inv_spd, matmul_shared
+from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import KalmanCorrection, drop_missing
+from .huber_filter import HuberCorrection
 from .kalman import OUTPUTS
 
-__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputKF", "AugmentedInputSTKF", "joseph_update"]
+__all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputHuberSTKF", "AugmentedInputKF",
+           "AugmentedInputSTKF"]
 
 #: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
 _TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
 
 
-def joseph_update(P, H, R, innovation):
-    """Kalman correction (E2), batched; returns ``(δx, P⁺, S)``, S = H P Hᵀ + R the innovation covariance.
-
-    ``P`` is (n, n) shared with ``H`` (m, n), or per run (runs, n, n) with
-    ``H`` (m, n) or (runs, m, n).
-    """
-    HT = np.swapaxes(H, -1, -2)
-    PHT = matmul_shared(P, HT)
-    S = H @ PHT + R if PHT.ndim == 2 else matmul_shared(np.swapaxes(PHT, -1, -2), HT) + R  # H P Hᵀ + R (P symmetric)
-    K = PHT @ inv_spd(S)
-    if K.ndim == 2:
-        dx = innovation @ K.T
-    else:
-        dx = (K @ innovation[..., None])[..., 0]
-    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
-    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
-    return dx, 0.5 * (P_post + np.swapaxes(P_post, -1, -2)), S
-
-
-class AugmentedEKF(Estimator):
+class AugmentedEKF(KalmanCorrection, Estimator):
     """EKF in error coordinates with augmented random-walk states (E1)–(E2); see the module docstring.
 
     Parameters
@@ -83,6 +67,9 @@ class AugmentedEKF(Estimator):
     uses_input : bool
     output : {"filtered", "predicted"}
     name : str
+    missing : {"refuse", "skip"}
+        A NaN channel: an InputError, or removed exactly at that step
+        (:func:`~hinfnav.estimators.correction.drop_missing`).
     """
 
     name = "augmented ekf"
@@ -90,8 +77,8 @@ class AugmentedEKF(Estimator):
     linear_model = False
 
     def __init__(self, system, measurement, *, n_cov, aug_input, P0, Q, base_noise=None, R=None, uses_input=False,
-                 output="filtered", name=None):
-        super().__init__(system, measurement, name=name)
+                 output="filtered", name=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         self.n_cov = int(n_cov)
         self.E = np.asarray(aug_input, dtype=float)
         if self.E.ndim != 2 or self.E.shape[0] != self.n_cov:
@@ -170,8 +157,11 @@ class AugmentedEKF(Estimator):
         """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
         return self.Qd, {}
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H):
-        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1)."""
+    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1).
+
+        ``innovation`` and ``H`` are zero on the channels ``~mask`` a reading lacks (mask None: none).
+        """
         return PhiPPhiT + Qd, {}, {}
 
     def after_update(self, state, x_post):
@@ -188,7 +178,7 @@ class AugmentedEKF(Estimator):
 
     # -- the step contract ---------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         if self.parameter_runs is not None and runs != self.parameter_runs:
             raise InputError(f"runs must equal the number of per-run parameter values ({self.parameter_runs}); got {runs}")
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
@@ -198,44 +188,51 @@ class AugmentedEKF(Estimator):
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
-    def update(self, state, y):
+    def _update(self, state, y):
         x = state.x
-        y = np.asarray(y, dtype=float)
         try:
             yhat, H = self.observe(x)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
+        mask = available_channels(y) if self.missing == "skip" else None
+        if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
+            y = np.where(mask, y, yhat)
         innovation = self.measurement.residual(y, yhat)
+        R, used = self.R, innovation
+        if mask is not None:
+            _, H, R, used = drop_missing(state.P, H, R, innovation, mask)
         diag = self.initial_diagnostics(x.shape[0])
         diag.update(self.step_diagnostics(state))
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         if "PhiPPhiT" in state.extra:
-            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, innovation, H)
+            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, used, H,
+                                                        mask=mask)
             diag.update(d_hook)
             extra.update(e_hook)
         else:
             P = state.P
+        if mask is not None:
+            P, H, R, used = drop_missing(P, H, R, used, mask)
         try:
-            dx, P_post, S = joseph_update(P, H, self.R, innovation)
+            dx, P_post, d_corr = self.correct_error(P, H, R, used)
         except np.linalg.LinAlgError:
-            dx = P_post = S = np.array(np.nan)
+            dx = P_post = np.array(np.nan)
         if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         x_post = self.inject(x, dx)
         extra.update(self.after_update(state, x_post))
-        diag.update(innovation=innovation, input_estimate=self.augmented(x_post),
-                    innovation_covariance=self._runs(S, x.shape[0]))
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         runs = x.shape[0]
+        diag.update(d_corr, innovation=innovation if mask is None else np.where(mask, innovation, np.nan),
+                    input_estimate=self.augmented(x_post))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         if self.output == "filtered":
             return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
                                    diagnostics=diag)
         return new, StepOutput(xhat=self.report(x), P=self._runs(self.report_covariance(P), runs), diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        u = None if u is None else np.asarray(u, dtype=float)
         Qd, e_noise = self.process_noise(state)
         Phi = self.transition(state.x, u)
         x = self.propagate_mean(state.x, u)
@@ -280,7 +277,8 @@ class AugmentedInputKF(AugmentedEKF):
 
     name = "augmented input kf"
 
-    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None):
+    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None,
+                 missing="refuse"):
         for attr in ("Phi", "Gamma"):
             if not hasattr(system, attr):
                 raise InputError(f"system must be a hinfnav LinearSystem (with Phi, Gamma); got {type(system).__name__}")
@@ -296,7 +294,7 @@ class AugmentedInputKF(AugmentedEKF):
         base[:n, :n] = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
         E = np.vstack([np.zeros((n, m)), np.eye(m)])
         super().__init__(system, measurement, n_cov=n + m, aug_input=E, P0=P0, Q=Q_input, base_noise=base, R=R,
-                         uses_input=False, output=output, name=name)
+                         uses_input=False, output=output, name=name, missing=missing)
         self.Phi_a = np.block([[system.Phi, system.Gamma], [np.zeros((m, n)), np.eye(m)]])
         self._n = n
         self.linear_model = bool(measurement.linear)
@@ -343,3 +341,14 @@ class AugmentedInputAdaptiveKF(RateAdaptive, AugmentedInputKF):
     """:class:`AugmentedInputKF` whose input noise follows the input's estimated rate (``window``, ``epsilon``, ``floor``)."""
 
     name = "augmented input adaptive kf"
+
+
+class AugmentedInputHuberSTKF(HuberCorrection, StrongTracking, AugmentedInputKF):
+    """Huber × strong tracking: :class:`AugmentedInputSTKF` whose correction is Huber's M-estimation.
+
+    Extra parameters ``gamma``, ``tol``, ``max_iter``
+    (:class:`~hinfnav.estimators.huber_filter.HuberCorrection`) and ``rho``,
+    ``beta``, ``a`` (:class:`~hinfnav.estimators.adaptive.StrongTracking`).
+    """
+
+    name = "augmented input huber stkf"

@@ -23,6 +23,15 @@ input u_k held over [t_k, t_{k+1}) (ignored unless ``uses_input``).
 loops over the steps with all runs at once; a subclass may override it with a
 faster path that gives the same numbers (tested by the contract suite).
 
+The public ``start``/``update``/``predict`` trust nothing: they check the call
+order (``FilterState.phase``), the shapes and finiteness of ``xhat0``, ``P0``,
+y and u, and name the parameter and the step in an
+:class:`~hinfnav.core.exceptions.InputError`; then they call the hooks
+``_start``/``_update``/``_predict`` that each estimator implements. The batch
+``estimate`` checks its arrays once and calls the hooks directly.
+``missing="skip"`` (a constructor option of every filter, or the
+:attr:`Estimator.missing` property) lets a NaN channel mark a missing reading.
+
 Variants override one hook: the Huber filter the correction, a strong-tracking
 filter the covariance prediction, an augmented filter the system it is built
 on, a saturated-measurement filter the update when a channel is clipped.
@@ -33,9 +42,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.exceptions import InputError
-from ..core.validation import as_vector
+from ..core.validation import as_choice, as_int_at_least, as_vector
 
-__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "history_keys"]
+__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "history_keys",
+           "MISSING", "PHASES", "available_channels"]
+
+#: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
+MISSING = ("refuse", "skip")
+#: Where a :class:`FilterState` is in the step cycle: "prior" (expects ``update``), "posterior" (expects ``predict``).
+PHASES = ("prior", "posterior")
+
+
+def available_channels(y):
+    """Mask of the finite channels of a reading ``y`` (runs, m), or None when every channel is there."""
+    ok = ~np.isnan(y)
+    return None if ok.all() else ok
 
 
 @dataclass
@@ -52,12 +73,16 @@ class FilterState:
         Index of the next measurement.
     extra : dict
         Anything else a filter keeps (last measurement, posterior, windows).
+    phase : {"prior", "posterior"}
+        "prior" after ``start``/``predict`` (the next call must be
+        ``update``), "posterior" after ``update`` (the next must be ``predict``).
     """
 
     x: np.ndarray
     P: np.ndarray = None
     k: int = 0
     extra: dict = field(default_factory=dict)
+    phase: str = "prior"
 
     @property
     def runs(self):
@@ -129,15 +154,22 @@ def history_keys(keep_covariance, diagnostics):
         raise InputError(f"diagnostics must be True, False or names of diagnostics; got {diagnostics!r}") from None
 
 
-def check_estimator_inputs(y, u, xhat0, n_state, n_meas=None, n_input=None):
-    """Validate the arguments of :meth:`Estimator.estimate`; return float arrays."""
+def check_estimator_inputs(y, u, xhat0, n_state, n_meas=None, n_input=None, missing="refuse"):
+    """Validate the arguments of :meth:`Estimator.estimate`; return float arrays.
+
+    With ``missing="skip"`` a NaN in y marks a missing channel (inf is still refused).
+    """
     y = np.asarray(y, dtype=float)
     if y.ndim != 3:
         raise InputError(f"y must have shape (runs, n_samples, n_meas); got {y.shape}")
     if n_meas is not None and y.shape[2] != n_meas:
         raise InputError(f"y must have {n_meas} measurement channels; got {y.shape[2]}")
-    if not np.all(np.isfinite(y)):
-        raise InputError("y (the measurements) must contain only finite numbers; it has NaN or inf entries")
+    if missing == "skip":
+        if np.any(np.isinf(y)):
+            raise InputError("y (the measurements) must not contain inf (NaN marks a missing channel with missing='skip')")
+    elif not np.all(np.isfinite(y)):
+        raise InputError("y (the measurements) must contain only finite numbers; it has NaN or inf entries "
+                         "(a filter built with missing='skip' skips NaN channels)")
     u = np.asarray(u, dtype=float)
     if u.ndim != 3 or u.shape[:2] != y.shape[:2]:
         raise InputError(f"u must have shape (runs, n_samples, n_input) matching y {y.shape[:2]}; got {u.shape}")
@@ -173,7 +205,7 @@ class Estimator:
     uses_input = False
     vectorized = True
 
-    def __init__(self, system, measurement, *, name=None):
+    def __init__(self, system, measurement, *, name=None, missing="refuse"):
         for attr in ("n", "dt", "state"):
             if not hasattr(system, attr):
                 raise InputError(f"system must be a hinfnav system (with n, dt, state); got {type(system).__name__}")
@@ -185,6 +217,16 @@ class Estimator:
         self.measurement = measurement
         if name is not None:
             self.name = str(name)
+        self.missing = missing
+
+    @property
+    def missing(self):
+        """Policy for NaN channels of a reading: "refuse" (an InputError) or "skip" (see :meth:`update`)."""
+        return self._missing
+
+    @missing.setter
+    def missing(self, value):
+        self._missing = as_choice("missing", value, MISSING)
 
     # -- dimensions ---------------------------------------------------------
 
@@ -203,24 +245,122 @@ class Estimator:
         """Sampling time, s."""
         return self.system.dt
 
-    # -- the step contract --------------------------------------------------
+    # -- the step contract: checked public calls ------------------------------
 
     def start(self, xhat0, P0=None, runs=1):
-        """Initial filter state for ``runs`` runs, with prior estimate ``xhat0``."""
-        raise NotImplementedError
+        """Initial filter state for ``runs`` runs, with prior estimate ``xhat0`` (shape (n,)).
+
+        ``P0`` (a finite square matrix; its size is the filter's covariance
+        dimension) overrides the filter's default. Raises InputError naming
+        ``xhat0``, ``P0`` or ``runs``.
+        """
+        xhat0 = as_vector("xhat0", xhat0, self.n_state)
+        runs = as_int_at_least("runs", runs, 1)
+        if P0 is not None:
+            P0 = np.asarray(P0, dtype=float)
+            if P0.ndim != 2 or P0.shape[0] != P0.shape[1]:
+                raise InputError(f"P0 must be a square matrix; got shape {P0.shape}")
+            if not np.all(np.isfinite(P0)):
+                raise InputError("P0 must contain only finite numbers; it has NaN or inf entries")
+        return self._phase(self._start(xhat0, P0, runs), None, "prior")
 
     def update(self, state, y):
-        """Consume y_k (shape (runs, n_meas)); return ``(state, StepOutput)``."""
-        raise NotImplementedError
+        """Consume y_k (shape (runs, n_meas)); return ``(state, StepOutput)``.
+
+        Checks the call order (after ``start`` or ``predict``), the shape of
+        y and its finiteness: with ``missing="skip"`` a NaN channel is not
+        used at this step, a reading with every channel NaN skips the update.
+        """
+        self._check_order(state, "update", "prior")
+        k, runs, m = state.k, state.x.shape[0], self.measurement.n_meas
+        try:
+            y = np.asarray(y, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"filter {self.name!r}: y at step {k} must be an array of real numbers") from None
+        if y.shape != (runs, m):
+            raise InputError(f"filter {self.name!r}: y at step {k} must have shape (runs, n_meas) = ({runs}, {m}); "
+                             f"got {y.shape}")
+        if self._missing == "skip":
+            if np.any(np.isinf(y)):
+                raise InputError(f"filter {self.name!r}: y at step {k} has inf entries (NaN marks a missing channel)")
+        elif not np.all(np.isfinite(y)):
+            raise InputError(f"filter {self.name!r}: y at step {k} must contain only finite numbers; it has NaN or "
+                             "inf entries (build the filter with missing='skip' to skip NaN channels)")
+        new, out = self._update(state, y)
+        return self._phase(new, state, "posterior"), out
 
     def predict(self, state, u=None):
-        """Propagate to t_{k+1} with the input u_k (shape (runs, n_input)); return the state."""
-        raise NotImplementedError
+        """Propagate to t_{k+1} with the input u_k (shape (runs, n_input)); return the state.
+
+        Checks the call order (after ``update``) and u: required when the
+        filter ``uses_input``; when given, of shape (runs, ·) and finite.
+        """
+        self._check_order(state, "predict", "posterior")
+        u = self._check_step_input(state, u, "predict")
+        return self._phase(self._predict(state, u), state, "prior")
 
     def step(self, state, y, u=None):
         """``update`` with y_k, then ``predict`` with u_k; returns ``(state, StepOutput)``."""
         state, out = self.update(state, y)
         return self.predict(state, u), out
+
+    def _check_order(self, state, call, phase):
+        if not isinstance(state, FilterState):
+            raise InputError(f"filter {self.name!r}: {call} needs the FilterState returned by start (call order: "
+                             f"start, then update and predict alternately); got {type(state).__name__}")
+        if state.phase != phase:
+            wanted = "update" if state.phase == "prior" else "predict"
+            raise InputError(f"filter {self.name!r}: wrong call order at step {state.k}: {call} after "
+                             f"{'update' if state.phase == 'posterior' else 'start or predict'}; call {wanted} first "
+                             "(order: start, then update and predict alternately)")
+
+    def _check_step_input(self, state, u, call):
+        """u of a step: None (allowed unless the filter uses it) or a finite (runs, n_input) array."""
+        k, runs = state.k, state.x.shape[0]
+        if u is None:
+            if self.uses_input:
+                raise InputError(f"filter {self.name!r} uses the applied input: {call} at step {k} needs u")
+            return None
+        try:
+            u = np.asarray(u, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"filter {self.name!r}: u at step {k} must be an array of real numbers") from None
+        n_in = self.n_input if self.uses_input else None
+        if u.ndim != 2 or u.shape[0] != runs or (n_in is not None and u.shape[1] != n_in):
+            want = f"({runs}, {n_in})" if n_in is not None else f"({runs}, n_input)"
+            raise InputError(f"filter {self.name!r}: u at step {k} must have shape {want}; got {u.shape}")
+        if not np.all(np.isfinite(u)):
+            raise InputError(f"filter {self.name!r}: u at step {k} must contain only finite numbers; it has NaN or "
+                             "inf entries")
+        return u
+
+    def _check_feed_input(self, state, u):
+        """The input a reading contains (``feed_input`` of a filter whose readings hold ``D u``): checked as
+        ``predict`` checks u, between ``start``/``predict`` and ``update``."""
+        self._check_order(state, "feed_input", "prior")
+        return self._check_step_input(state, u, "feed_input")
+
+    @staticmethod
+    def _phase(new, old, phase):
+        """``new`` marked with ``phase`` (a copy when a hook handed back the state it was given)."""
+        if new is old:
+            new = FilterState(x=new.x, P=new.P, k=new.k, extra=dict(new.extra))
+        new.phase = phase
+        return new
+
+    # -- the step contract: hooks of the subclasses (inputs already checked) ---
+
+    def _start(self, xhat0, P0, runs):
+        """Initial filter state (``xhat0`` a finite (n,) vector, ``P0`` None or a finite square matrix)."""
+        raise NotImplementedError
+
+    def _update(self, state, y):
+        """Consume a checked y_k (runs, n_meas); return ``(state, StepOutput)``."""
+        raise NotImplementedError
+
+    def _predict(self, state, u):
+        """Propagate with a checked u_k (runs, n_input) or None; return the state."""
+        raise NotImplementedError
 
     # -- batch --------------------------------------------------------------
 
@@ -251,14 +391,14 @@ class Estimator:
         """
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None)
+                                             self.n_input if self.uses_input else None, self.missing)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
-        state = self.start(xhat0, P0, runs)
+        state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks
         xhat = np.empty((runs, n1, self.n_state))
         P_hist, shared, diag = None, False, {}
         for k in range(n1):
-            state, out = self.update(state, y[:, k])
+            state, out = self._update(state, y[:, k])
             xhat[:, k] = out.xhat
             if keep_covariance and out.P is not None:
                 P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
@@ -266,6 +406,9 @@ class Estimator:
                     # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
                     shared = P.ndim == core or P.strides[0] == 0
                     P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
+                if shared and not (P.ndim == core or P.strides[0] == 0):
+                    # a skipped channel in some runs only: the covariance becomes per run from here on
+                    P_hist, shared = np.broadcast_to(P_hist, (runs,) + P_hist.shape).copy(), False
                 if shared:
                     P_hist[k] = P if P.ndim == core else P[0]
                 else:
@@ -277,7 +420,7 @@ class Estimator:
                         diag[key] = np.empty((runs, n1) + val.shape[1:], dtype=val.dtype)
                     diag[key][:, k] = val
             if k < n1 - 1:
-                state = self.predict(state, u[:, k])
+                state = self._predict(state, u[:, k])
         if shared:
             P_hist.setflags(write=False)
             P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)

@@ -27,23 +27,22 @@ the filter the input held when the reading was taken with ``feed_input``
 before ``update``; without it the reading is taken to exclude the input part.
 
 Every filter can freeze its gains once the covariance recursion has
-converged (``steady_tol``: largest change of P⁻ per step, each entry relative
-to √(P_ii P_jj), checked over blocks of ``CHECK_EVERY`` steps; ``None``, the
-default, never freezes); for a state without process noise the recursion
-converges at the rate θ per step, so its gains are then within about
-``steady_tol/θ`` of their limit. A clipped reading unfreezes Algorithms 2, 3.
+converged (``steady_tol``, :func:`hinfnav.estimators.steady.freeze_gain`;
+``None``, the default, never freezes). A clipped reading unfreezes Algorithms 2, 3.
 """
 
 import numpy as np
 
 from ..analysis.truncated import truncated_normal_moments
 from ..core.exceptions import InputError
-from ..core.linalg import as_covariance, inv_spd
+from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_positive, as_vector
 from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import drop_missing, kalman_gain
+from .steady import CHECK_EVERY, freeze_gain
 from .kalman import ExtendedKalmanFilter
 
 __all__ = ["ExtendedStateKalmanFilter", "SaturatedExtendedStateFilter", "FusedExtendedStateFilter",
@@ -62,20 +61,6 @@ def theta_star(Q1, P0):
         raise InputError(f"theta* = sqrt(tr Q1 / tr P0) needs tr Q1 > 0 and tr P0 > 0; got {num:.3g}, {den:.3g}: "
                          "give theta explicitly")
     return float(np.sqrt(num / den))
-
-
-#: The convergence of P⁻ is checked every CHECK_EVERY steps (against P⁻ of CHECK_EVERY steps before).
-CHECK_EVERY = 64
-
-
-def _converged(new, old, tol):
-    """Largest change of P⁻ since the last check, each entry relative to √(P_ii P_jj), at most ``tol`` per step."""
-    if tol is None or old is None or np.shape(new) != np.shape(old):
-        return False
-    tol = tol * CHECK_EVERY
-    d = np.sqrt(np.abs(np.diagonal(new, axis1=-2, axis2=-1)))
-    scale = d[..., :, None] * d[..., None, :]
-    return bool(np.all(np.abs(new - old) <= tol * scale))
 
 
 def _check_tol(steady_tol):
@@ -118,7 +103,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
     name = "eskf"
 
     def __init__(self, system, measurement, *, P0, B_e, q, S=None, R=None, theta=None, nominal=None, steady_tol=None,
-                 name=None):
+                 name=None, missing="refuse"):
         n = system.n
         self.B_e = as_matrix("B_e", B_e, (n, None))
         self.q = as_vector("q", q, self.B_e.shape[1])
@@ -134,7 +119,8 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         P0c = as_covariance("P0", P0, n, definite=True)
         self.theta = theta_star(self.Q1, P0c) if theta is None else as_positive("theta", theta)
         Q = (1.0 + 1.0 / self.theta) * self.Q1 + self.Q2
-        super().__init__(system, measurement, P0=P0c, Q=0.5 * (Q + Q.T), R=R, uses_input=True, name=name)
+        super().__init__(system, measurement, P0=P0c, Q=0.5 * (Q + Q.T), R=R, uses_input=True, name=name,
+                         missing=missing)
         if nominal is not None and not callable(nominal):
             raise InputError("nominal must be a callable k -> f_bar_k")
         self.nominal = nominal
@@ -145,18 +131,20 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` (Algorithm 1)."""
         return (1.0 + self.theta) * (self.F @ P @ self.F.T) + self.Q
 
-    def gain(self, P_prior):
-        """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run)."""
-        H = self.measurement.H
-        PHT = P_prior @ H.T
-        K = PHT @ inv_spd(H @ PHT + self.R)
-        I_KH = self._I - K @ H
-        P_post = I_KH @ P_prior @ np.swapaxes(I_KH, -1, -2) + K @ self.R @ np.swapaxes(K, -1, -2)
+    def gain(self, P_prior, H=None, R=None):
+        """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run).
+
+        ``H``, ``R`` default to the measurement's; :func:`~hinfnav.estimators.correction.kalman_gain`.
+        """
+        K, P_post, _ = kalman_gain(P_prior, self.measurement.H if H is None else H, self.R if R is None else R,
+                                   symmetrize=False)
         return K, P_post
 
-    def correct(self, x, P, H, innovation, state):
+    def correct(self, x, P, H, innovation, state, R=None):
         steady = state.extra.get("steady")
-        if steady is not None and "K" in steady:
+        if R is not None:  # missing channels: this step's gain, not the steady one
+            K, P_post = self.gain(P, H, R)
+        elif steady is not None and "K" in steady:
             K, P_post = steady["K"], steady["P_post"]
         else:
             K, P_post = self.gain(P)
@@ -168,23 +156,26 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             x_post = x + np.einsum("rij,rj->ri", K, innovation)
         return x_post, P_post, {"theta": np.full(x.shape[0], self.theta)}
 
-    def update(self, state, y):
-        """As :meth:`ExtendedKalmanFilter.update`, without re-evaluating the (linear) measurement's Jacobian."""
+    def _update(self, state, y):
+        """As :meth:`ExtendedKalmanFilter._update`, without re-evaluating the (linear) measurement's Jacobian."""
         if not self.measurement.linear:
-            return super().update(state, y)
+            return super()._update(state, y)
         x, P = state.x, state.P
         H = self.measurement.H
-        innovation = np.asarray(y, dtype=float) - x @ H.T
-        x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        innovation = y - x @ H.T
+        mask = available_channels(y) if self.missing == "skip" else None
+        if mask is None:
+            x_post, P_post, diag = self.correct(x, P, H, innovation, state)
+        else:
+            P, H_used, R_used, used = drop_missing(P, H, self.R, innovation, mask)
+            x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
         diag["innovation"] = innovation
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
 
-    def predict(self, state, u=None):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+    def _predict(self, state, u):
         x = self.predict_mean(state.x, np.asarray(u, dtype=float))
         if self.nominal is not None:
             x = x + _increment(self.nominal, state.k, self._q_sqrt) @ self.B_e.T
@@ -194,10 +185,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
             P = steady["P_prior"]
         else:
             P = self.predict_covariance(state.P, state)
-            if self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-                if _converged(P, state.extra.get("check_prior"), self.steady_tol):
-                    steady = {"P_prior": P}
-                extra["check_prior"] = P
+            steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
         extra["steady"] = steady
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
@@ -248,7 +236,8 @@ class SaturatedExtendedStateFilter(Estimator):
     uses_input = True
 
     def __init__(self, A_d, B_d, C, D, *, R, S, q, P0, lower, upper, dt, mode="truncated", state=None,
-                 measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None):
+                 measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None,
+                 missing="refuse"):
         A_d = np.asarray(A_d, dtype=float)
         if A_d.ndim != 3 or A_d.shape[1:] != (3, 3):
             raise InputError(f"A_d must have shape (n_axes, 3, 3); got {A_d.shape}")
@@ -301,7 +290,7 @@ class SaturatedExtendedStateFilter(Estimator):
         system = LinearSystem(Phi, Gam, np.zeros((3 * na, 1)), as_positive("dt", dt), state, name="per-axis [r, v, f]")
         meas = Saturated(LinearMeasurement(Cm, np.diag(np.sqrt(self.Reff)), labels=measurement_labels,
                                            units=measurement_units), self.lower, self.upper)
-        super().__init__(system, meas, name=name)
+        super().__init__(system, meas, name=name, missing=missing)
         self._I3 = np.eye(3)
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
 
@@ -333,15 +322,24 @@ class SaturatedExtendedStateFilter(Estimator):
             return np.zeros(np.shape(y), dtype=bool)
         return (y <= self.lower) | (y >= self.upper)
 
-    def kernel_update(self, X, P, y, u_feed, cache=None, sat=None, skip=None):
+    def kernel_update(self, X, P, y, u_feed, cache=None, sat=None, skip=None, missing=None):
         """One measurement update on arrays ``X`` (runs, n_axes, 3), ``P`` (runs, n_axes, 3, 3).
 
         ``y``, ``u_feed`` (runs, n_axes): readings and the input they contain. ``cache = (K, P_post)`` of a
         converged recursion is used when no reading is clipped; ``sat`` (default :meth:`flags`) marks the
         clipped readings, ``skip`` (default ``mode == "skip"``, per run or per reading) those to skip rather
-        than replace by the truncated moments. Returns ``(X, P, innovation, flags, K)``.
+        than replace by the truncated moments; ``missing`` (runs, n_axes) marks readings that are not there
+        (NaN; their gain is 0, so the update keeps the prediction, exactly). Returns
+        ``(X, P, innovation, flags, K)``.
         """
         yhat = (X[..., None, :] @ self._Ccol)[..., 0, 0] + self.Dff * u_feed
+        if missing is not None and missing.any():
+            y = np.where(missing, yhat, y)
+            sat = (self.flags(y) if sat is None else sat) & ~missing
+            skip = (self.mode == "skip") if skip is None else skip
+            skip = np.reshape(skip, np.shape(skip) + (1,) * (missing.ndim - np.ndim(skip))) | missing
+            sat = sat | missing  # handled as skipped readings
+            cache = None
         sat = self.flags(y) if sat is None else sat
         any_sat = sat.any()
         if cache is not None and not any_sat:
@@ -384,7 +382,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     # -- the step contract ---------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         x0 = as_vector("xhat0", xhat0, self.n_state)
         X = np.broadcast_to(self.from_full(x0[None]), (runs, self.n_axes, 3)).copy()
         P = self.P0 if P0 is None else self.from_full_cov(P0)
@@ -393,10 +391,8 @@ class SaturatedExtendedStateFilter(Estimator):
 
     def feed_input(self, state, u):
         """The state with the input ``u_k`` (runs, n_axes) that the next reading contains through ``D u_k``."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (state.x.shape[0], self.n_axes):
-            raise InputError(f"u must have shape (runs, {self.n_axes}); got {u.shape}")
-        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u))
+        u = self._check_feed_input(state, u)
+        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u), phase=state.phase)
 
     def from_full_cov(self, P0):
         """A full (3 n_axes)² covariance → its per-axis blocks (cross-axis terms are dropped)."""
@@ -404,11 +400,18 @@ class SaturatedExtendedStateFilter(Estimator):
         na = self.n_axes
         return np.stack([P0[np.ix_(np.arange(3) * na + a, np.arange(3) * na + a)] for a in range(na)])
 
-    def update(self, state, y):
+    def _update(self, state, y):
         y = np.asarray(y, dtype=float)
         steady = state.extra.get("steady")
         cache = None if steady is None or "K" not in steady else (steady["K"], steady["P_post"])
-        X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], cache)
+        miss = np.isnan(y) if self.missing == "skip" else None
+        if miss is not None and miss.any():
+            X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], missing=miss)
+            sat = sat & ~miss
+            innov = np.where(miss, np.nan, innov)
+            steady = None if steady is None else {key: v for key, v in steady.items() if key not in ("K", "P_post")}
+        else:
+            X, P, innov, sat, K = self.kernel_update(state.x, state.P, y, state.extra["u_feed"], cache)
         if steady is not None and sat.any():
             steady = None  # a clipped reading: the covariance depends on the data again
         elif steady is not None and "K" not in steady:
@@ -418,19 +421,15 @@ class SaturatedExtendedStateFilter(Estimator):
         new = FilterState(x=X, P=P, k=state.k, extra=extra)
         return new, StepOutput(xhat=self.to_full(X), P=self.full_covariance(P), diagnostics=diag)
 
-    def predict(self, state, u=None):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+    def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
         steady = state.extra.get("steady")
         X, P = self.kernel_predict(state.x, None if steady is not None else state.P, u)
         extra = dict(state.extra, u_feed=np.zeros_like(u))
         if steady is not None:
             P = steady["P_prior"]
-        elif self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-            if _converged(P, state.extra.get("check_prior"), self.steady_tol):
-                steady = {"P_prior": P}
-            extra["check_prior"] = P
+        else:
+            steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
         extra["steady"] = steady
         return FilterState(x=X, P=P, k=state.k + 1, extra=extra)
 
@@ -460,7 +459,8 @@ class FusedExtendedStateFilter(Estimator):
     name = "fused_eskf"
     uses_input = True
 
-    def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None):
+    def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None,
+                 missing="refuse"):
         if not isinstance(alg1, ExtendedStateKalmanFilter):
             raise InputError(f"alg1 must be an ExtendedStateKalmanFilter; got {type(alg1).__name__}")
         if not isinstance(alg2, SaturatedExtendedStateFilter):
@@ -489,7 +489,7 @@ class FusedExtendedStateFilter(Estimator):
                                            units=alg1.measurement.units + alg2.measurement.units),
                          np.r_[np.full(m1, -np.inf), alg2.lower],
                          np.r_[np.full(m1, np.inf), alg2.upper])
-        super().__init__(alg1.system, meas, name=name)
+        super().__init__(alg1.system, meas, name=name, missing=missing)
         self._m1 = m1
 
     def fuse(self, x1, P1, X2, P2):
@@ -509,42 +509,55 @@ class FusedExtendedStateFilter(Estimator):
         P1[:, self._rr, self._cc] = Po
         return x1, P1, Xo, Po
 
-    def start(self, xhat0, P0=None, runs=1):
-        s1 = self.alg1.start(xhat0, P0, runs)
+    def _start(self, xhat0, P0, runs):
+        s1 = self.alg1._start(xhat0, P0, runs)
         x0 = np.asarray(xhat0, dtype=float)
-        s2 = self.alg2.start(x0[self.idx], None if P0 is None else np.asarray(P0)[np.ix_(self.idx, self.idx)], runs)
+        s2 = self.alg2._start(x0[self.idx], None if P0 is None else np.asarray(P0)[np.ix_(self.idx, self.idx)], runs)
         P1 = np.broadcast_to(s1.P, (runs,) + s1.P.shape[-2:]).copy()
         return FilterState(x=s1.x, P=P1, extra={"X2": s2.x, "P2": s2.P, "u_feed": s2.extra["u_feed"], "steady": None})
 
     def feed_input(self, state, u):
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (state.x.shape[0], self.n_input):
-            raise InputError(f"u must have shape (runs, {self.n_input}); got {u.shape}")
-        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]))
+        u = self._check_feed_input(state, u)
+        return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
+                           phase=state.phase)
 
-    def update(self, state, y):
-        y = np.asarray(y, dtype=float)
-        x1, P1 = state.x, state.P
+    def _update(self, state, y):
+        x1, P1, X2, P2 = state.x, state.P, state.extra["X2"], state.extra["P2"]
         steady = state.extra["steady"]
-        a1 = self.alg1
-        innov1 = y[:, : self._m1] - x1 @ a1.measurement.H.T
-        cache2 = None if steady is None or "K2" not in steady else (steady["K2"], steady["P2_post"])
-        X2, P2, innov2, sat, K2 = self.alg2.kernel_update(state.extra["X2"], state.extra["P2"], y[:, self._m1:],
-                                                          state.extra["u_feed"], cache2)
-        if cache2 is not None and not sat.any():
-            K1 = steady["K1"]
-            x1 = x1 + (K1 @ innov1[..., None])[..., 0]
-            x1, X2 = self._fuse_mean(x1, X2)
-            P1, P2 = steady["P1_post"], steady["P2_post"]
-        else:
-            K1, P1p = a1.gain(P1)
-            x1 = x1 + (K1 @ innov1[..., None])[..., 0]
-            x1, P1, X2, P2 = self.fuse(x1, P1p, X2, P2)
+        a1, m1 = self.alg1, self._m1
+        innov1 = y[:, :m1] - x1 @ a1.measurement.H.T
+        miss = np.isnan(y) if self.missing == "skip" else None
+        if miss is not None and not miss.any():
+            miss = None
+        if miss is not None and miss.all():  # no reading at all: the prediction is the estimate (no fusion either)
+            innov2, sat = np.full((y.shape[0], y.shape[1] - m1), np.nan), np.zeros(X2.shape[:2], dtype=bool)
+        elif miss is not None:  # this step's gains without the missing channels (exact); the frozen gains kept aside
+            X2, P2, innov2, sat, _ = self.alg2.kernel_update(X2, P2, y[:, m1:], state.extra["u_feed"],
+                                                             missing=miss[:, m1:])
+            sat, innov2 = sat & ~miss[:, m1:], np.where(miss[:, m1:], np.nan, innov2)
+            P1m, H1, R1, used = drop_missing(P1, a1.measurement.H, a1.R, innov1, ~miss[:, :m1])
+            K1, P1p = a1.gain(P1m, H1, R1)
+            x1 = x1 + (K1 @ used[..., None])[..., 0] if K1.ndim == 3 else x1 + used @ K1.T
+            x1, P1, X2, P2 = self.fuse(x1, np.broadcast_to(P1p, P1.shape), X2, P2)
             if steady is not None:
-                steady = None if sat.any() else dict(steady, K1=K1, K2=K2, P1_post=P1, P2_post=P2)
-        runs = x1.shape[0]
-        th1, th2 = self._thetas(runs)
+                steady = None if sat.any() else {k: v for k, v in steady.items() if not k.endswith("post")
+                                                 and k not in ("K1", "K2")}
+        else:
+            cache2 = None if steady is None or "K2" not in steady else (steady["K2"], steady["P2_post"])
+            X2, P2, innov2, sat, K2 = self.alg2.kernel_update(X2, P2, y[:, m1:], state.extra["u_feed"], cache2)
+            if cache2 is not None and not sat.any():
+                K1 = steady["K1"]
+                x1 = x1 + (K1 @ innov1[..., None])[..., 0]
+                x1, X2 = self._fuse_mean(x1, X2)
+                P1, P2 = steady["P1_post"], steady["P2_post"]
+            else:
+                K1, P1p = a1.gain(P1)
+                x1 = x1 + (K1 @ innov1[..., None])[..., 0]
+                x1, P1, X2, P2 = self.fuse(x1, P1p, X2, P2)
+                if steady is not None:
+                    steady = None if sat.any() else dict(steady, K1=K1, K2=K2, P1_post=P1, P2_post=P2)
+        th1, th2 = self._thetas(x1.shape[0])
         diag = {"innovation": np.concatenate([innov1, innov2], axis=1), "saturated": sat, "theta": th1,
                 "theta_alg2": th2}
         extra = dict(state.extra, X2=X2, P2=P2, steady=steady)
@@ -567,9 +580,7 @@ class FusedExtendedStateFilter(Estimator):
         Xo = x1[:, self.idx].reshape(x1.shape[0], 3, -1).swapaxes(1, 2).copy()
         return x1, Xo
 
-    def predict(self, state, u=None):
-        if u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+    def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
         a1 = self.alg1
         x1 = a1.predict_mean(state.x, u)
@@ -584,10 +595,6 @@ class FusedExtendedStateFilter(Estimator):
         else:
             P1 = a1.predict_covariance(state.P, state)
             X2, P2 = self.alg2.kernel_predict(state.extra["X2"], state.extra["P2"], u2)
-            if self.steady_tol is not None and (state.k + 1) % CHECK_EVERY == 0:
-                if _converged(P1, state.extra.get("check_P1"), self.steady_tol) and _converged(
-                        P2, state.extra.get("check_P2"), self.steady_tol):
-                    steady = {"P1_prior": P1, "P2_prior": P2}
-                extra.update(check_P1=P1, check_P2=P2)
+            steady = freeze_gain(self.steady_tol, state.k, extra, P1_prior=P1, P2_prior=P2)
         extra.update(X2=X2, P2=P2, steady=steady)
         return FilterState(x=x1, P=P1, k=state.k + 1, extra=extra)

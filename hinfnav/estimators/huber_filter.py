@@ -27,15 +27,56 @@ rows), ``iterations`` and ``converged`` of the M-estimation, and the
 ``innovation``.
 """
 
+import numpy as np
+
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive
 from .huber import huber_correct, whitening
 from .kalman import ExtendedKalmanFilter
 
-__all__ = ["HuberFilter"]
+__all__ = ["HuberCorrection", "HuberFilter"]
 
 
-class HuberFilter(ExtendedKalmanFilter):
+class HuberCorrection:
+    """Mixin: Huber's M-estimation as the correction of any Kalman-type filter of the package.
+
+    Put it first in the bases of a filter with the ``correct_error`` hook
+    (:class:`~hinfnav.estimators.ExtendedKalmanFilter`,
+    :class:`~hinfnav.estimators.AugmentedEKF` and their variants: strong
+    tracking, the attitude filters). Keyword parameters ``gamma``, ``tol``,
+    ``max_iter`` as in :class:`HuberFilter`. The weights make P depend on the
+    data: every run carries its own covariance. Diagnostics: ``weights``,
+    ``iterations``, ``converged``, ``innovation_covariance`` (H P⁻ Hᵀ + R).
+    """
+
+    data_dependent_covariance = True
+
+    def __init__(self, *args, gamma=1.345, tol=1e-10, max_iter=50, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.gamma = as_positive("gamma", gamma)
+        self.tol = as_positive("tol", tol)
+        self.max_iter = as_int_at_least("max_iter", max_iter, 1)
+        self._LRi = None if self.R is None else whitening(self.R)  # constant R: whitened once
+
+    @property
+    def shares_covariance(self):
+        """Always False: the Huber weights, hence P, depend on the data."""
+        return False
+
+    def correct_error(self, P, H, R, innovation):
+        """Huber M-estimation of the correction δx; returns ``(δx, P⁺, diagnostics)`` (P per run)."""
+        if P.ndim == 2:
+            P = np.broadcast_to(P, (innovation.shape[0],) + P.shape)
+        dx, P_post, weights, iterations, converged = huber_correct(
+            None, P, innovation, H, R, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
+            LRi=self._LRi if R is self.R else None)
+        HT = np.swapaxes(H, -1, -2)
+        S = H @ P @ HT + R  # innovation covariance of the prior (the Kalman start of the regression)
+        return dx, P_post, {"weights": weights, "iterations": iterations, "converged": converged,
+                            "innovation_covariance": S}
+
+
+class HuberFilter(HuberCorrection, ExtendedKalmanFilter):
     """Huber-based filter on the step contract (see the module docstring).
 
     Parameters
@@ -60,12 +101,9 @@ class HuberFilter(ExtendedKalmanFilter):
     name = "hbf"
 
     def __init__(self, system, measurement, *, P0, Q=None, R=None, gamma=1.345, tol=1e-10, max_iter=50,
-                 uses_input=False, output="filtered", name=None):
-        super().__init__(system, measurement, P0=P0, Q=Q, R=R, uses_input=uses_input, output=output, name=name)
-        self.gamma = as_positive("gamma", gamma)
-        self.tol = as_positive("tol", tol)
-        self.max_iter = as_int_at_least("max_iter", max_iter, 1)
-        self._LRi = None if self.R is None else whitening(self.R)  # constant R: whitened once
+                 uses_input=False, output="filtered", name=None, missing="refuse"):
+        super().__init__(system, measurement, P0=P0, Q=Q, R=R, uses_input=uses_input, output=output, name=name,
+                         missing=missing, gamma=gamma, tol=tol, max_iter=max_iter)
 
     @classmethod
     def from_ekf(cls, ekf, *, gamma=1.345, tol=1e-10, max_iter=50, name=None):
@@ -78,18 +116,4 @@ class HuberFilter(ExtendedKalmanFilter):
             raise InputError(f"ekf must be a hinfnav ExtendedKalmanFilter; got {type(ekf).__name__}")
         return cls(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R, gamma=gamma, tol=tol,
                    max_iter=max_iter, uses_input=ekf.uses_input, output=ekf.output,
-                   name=name if name is not None else "hbf")
-
-    @property
-    def shares_covariance(self):
-        """Always False: the Huber weights, hence P, depend on the data."""
-        return False
-
-    def correct(self, x, P, H, innovation, state, R=None):
-        """Huber M-estimation update; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
-        LRi = self._LRi if R is None else None
-        R = self.R if R is None else R
-        dx, P_post, weights, iterations, converged = huber_correct(
-            None, P, innovation, H, R, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter, LRi=LRi)
-        diag = {"weights": weights, "iterations": iterations, "converged": converged}
-        return x + dx, P_post, diag
+                   name=name if name is not None else "hbf", missing=ekf.missing)

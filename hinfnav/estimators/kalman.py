@@ -1,7 +1,9 @@
 """Kalman filters on the step contract: the linear/extended Kalman filter, batched over runs.
 
 :class:`ExtendedKalmanFilter` propagates a linear system (its Jacobian is Φ)
-and linearizes the measurement model at the prior estimate. It is one
+or any dynamics model (``n``, ``n_input``, ``dt``, ``state``, ``Q``,
+``linear`` False, ``f(x, u, t)`` and ``jacobian(x, u, t)``: the Jacobian at
+x̂(k|k) propagates P) and linearizes the measurement model at the prior estimate. It is one
 class with small hooks that the variants override:
 
 * :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``
@@ -24,9 +26,10 @@ The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.linalg import as_covariance, congruence, inv_spd
+from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels
+from .correction import KalmanCorrection, drop_missing
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 
@@ -34,17 +37,13 @@ __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 OUTPUTS = ("filtered", "predicted")
 
 
-class ExtendedKalmanFilter(Estimator):
+class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     """Extended Kalman filter of a linear system with any measurement model.
 
     Parameters
     ----------
-    system : LinearSystem or dynamics model
-        Φ, Γ, B (Q = B Bᵀ by default), dt, state labels; or a nonlinear
-        dynamics model (:mod:`hinfnav.systems.dynamics`, ``linear`` False):
-        the mean is propagated by its ``f`` and P by ``F P Fᵀ + Q`` with F its
-        Jacobian at the posterior estimate (the hooks ``predict_mean`` and
-        ``predict_covariance`` are those of a linear system).
+    system : LinearSystem
+        Φ, Γ, B (Q = B Bᵀ by default), dt, state labels.
     measurement : MeasurementModel
         h, its Jacobian, R = D Dᵀ by default, residual (angles wrapped).
     P0 : array_like, shape (n, n)
@@ -62,12 +61,18 @@ class ExtendedKalmanFilter(Estimator):
     output : {"filtered", "predicted"}
         What ``update`` reports: x̂(k|k) (uses y_k) or x̂(k|k−1).
     name : str
+    missing : {"refuse", "skip"}
+        A NaN channel of a reading: an InputError, or not used at that step
+        (removed exactly, :func:`~hinfnav.estimators.correction.drop_missing`;
+        a reading without any channel leaves the prior as the estimate).
     """
 
     name = "ekf"
+    symmetric_posterior = False
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None):
-        super().__init__(system, measurement, name=name)
+    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
+                 missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         n, m = system.n, measurement.n_meas
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
         #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
@@ -82,11 +87,17 @@ class ExtendedKalmanFilter(Estimator):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
         self.uses_input = bool(uses_input)
         self.output = as_choice("output", output, OUTPUTS)
-        #: a nonlinear dynamics model (``linear`` False, see hinfnav.systems.dynamics): f and its Jacobian per run
+        #: the dynamics model's f(x, u, t) and Jacobian propagate when the system says it is not linear
         self.nonlinear_dynamics = not getattr(system, "linear", True)
-        self.F = None if self.nonlinear_dynamics else system.Phi
-        self.Gamma = None if self.nonlinear_dynamics else system.Gamma
-        self._I = np.eye(n)
+        if self.nonlinear_dynamics:
+            if not (callable(getattr(system, "f", None)) and callable(getattr(system, "jacobian", None))):
+                raise InputError(f"system {type(system).__name__} says it is not linear but has no f(x, u, t) and "
+                                 "jacobian(x, u, t)")
+        elif getattr(system, "Phi", None) is None:
+            raise InputError(f"system must be a LinearSystem (with Phi) or a dynamics model (f, jacobian); got "
+                             f"{type(system).__name__}")
+        self.F = getattr(system, "Phi", None)
+        self.Gamma = getattr(system, "Gamma", None)
 
     @property
     def shares_covariance(self):
@@ -95,16 +106,21 @@ class ExtendedKalmanFilter(Estimator):
 
     # -- hooks ------------------------------------------------------------------
 
-    def predict_mean(self, x, u):
-        """``Φ x̂ (+ Γ u)`` for a batch of estimates."""
+    def predict_mean(self, x, u, t=0.0):
+        """``Φ x̂ (+ Γ u)`` for a batch of estimates, or the dynamics model's ``f(x̂, u, t)`` (t the time of x̂, s)."""
+        if self.nonlinear_dynamics:
+            return self.system.f(x, u if self.uses_input else None, t)
         out = x @ self.F.T
         if self.uses_input:
             out = out + u @ self.Gamma.T
         return out
 
-    def predict_covariance(self, P, state):
-        """``Φ P Φᵀ + Q`` (P shared (n, n) or per run (runs, n, n))."""
-        return congruence(self.F, P) + self.Q
+    def predict_covariance(self, P, state, F=None):
+        """``F P Fᵀ + Q`` with F = Φ, or the dynamics model's Jacobian at x̂(k|k) ((n, n) or (runs, n, n))."""
+        F = self.F if F is None else F
+        if F.ndim == 3:
+            return F @ P @ np.swapaxes(F, -1, -2) + self.Q
+        return congruence(F, P) + self.Q
 
     def measurement_covariance(self, y, x):
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
@@ -115,48 +131,45 @@ class ExtendedKalmanFilter(Estimator):
         return None if self.R_of_reading is None else self.R_of_reading(y)
 
     def correct(self, x, P, H, innovation, state, R=None):
-        """Joseph-form Kalman update; returns ``(x⁺, P⁺, diagnostics)``.
+        """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
 
-        ``H`` is (m, n) when P is shared, (runs, m, n) otherwise; ``R`` is
-        the step's covariance when it depends on the reading (default the
-        constant :attr:`R`).
+        Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
+        (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
+        on the reading or on the missing channels (default the constant :attr:`R`).
         """
-        R = self.R if R is None else R
-        HT = np.swapaxes(H, -1, -2)
-        PHT = P @ HT
-        S = H @ PHT + R
-        K = PHT @ inv_spd(S)
-        if K.ndim == 2:
-            x_post = x + innovation @ K.T
-        else:
-            x_post = x + np.einsum("rij,rj->ri", K, innovation)
-        I_KH = self._I - K @ H
-        P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2)
-        return x_post, P_post, {"innovation_covariance": self._broadcast(S, x.shape[0])}
+        dx, P_post, diag = self.correct_error(P, H, self.R if R is None else R, innovation)
+        return x + dx, P_post, diag
 
     # -- the step contract --------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
         x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
         if not self.shares_covariance:
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
-    def update(self, state, y):
+    def _update(self, state, y):
         x, P = state.x, state.P
-        y = np.asarray(y, dtype=float)
+        mask = available_channels(y) if self.missing == "skip" else None
         try:
             H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
-            innovation = self.measurement.residual(y, self.measurement.function(x))
+            yhat = self.measurement.function(x)
+            if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
+                y = np.where(mask, y, yhat)
+            innovation = self.measurement.residual(y, yhat)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         R_k = self.measurement_covariance(y, x)
-        if R_k is None:
-            x_post, P_post, diag = self.correct(x, P, H, innovation, state)
-        else:
+        if mask is None:
             x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
-        diag = dict(diag, innovation=innovation)
+        else:
+            if R_k is not None:  # a reading-dependent R not finite on the channels it has: the reading is not used
+                both = mask[:, :, None] & mask[:, None, :]
+                mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
+            P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+            x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
+        diag = dict(diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
         if self.output == "filtered":
             out = StepOutput(xhat=x_post, P=self._broadcast(P_post, x.shape[0]), diagnostics=diag)
@@ -164,14 +177,14 @@ class ExtendedKalmanFilter(Estimator):
             out = StepOutput(xhat=x, P=self._broadcast(P, x.shape[0]), diagnostics=diag)
         return new, out
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        u = None if u is None else np.asarray(u, dtype=float)
-        if self.nonlinear_dynamics:  # x̂⁻ = f(x̂, u, t_k), P⁻ = F P Fᵀ + Q with F = ∂f/∂x at x̂ (per run)
-            args = (state.x, u if self.uses_input else None, state.k * self.dt)
-            x = self.system.f(*args)
-            P = congruence(self.system.jacobian(*args), state.P) + self.Q
+        if self.nonlinear_dynamics:  # the Jacobian at the posterior x̂(k|k), before the mean moves on
+            t = state.k * self.dt
+            F = np.asarray(self.system.jacobian(state.x, u if self.uses_input else None, t), dtype=float)
+            P = self.predict_covariance(state.P, state, F=F)
+            x = self.predict_mean(state.x, u, t)
         else:
             x = self.predict_mean(state.x, u)
             P = self.predict_covariance(state.P, state)

@@ -39,6 +39,11 @@ class LTIFilter(Estimator):
         known-input correction (then ``uses_input`` is True).
     K : array_like, shape (m_u, n), optional
         The feedback gain the design assumed.
+    missing : {"refuse", "skip"}
+        A NaN channel of a reading: an InputError, or (fixed gains) replaced
+        by the reading the filter predicts from its estimate, ``h(x̂(k))``,
+        so that it drives the filter with a zero innovation (documented
+        choice: the gain B_F is not re-designed for the channels left).
 
     Notes
     -----
@@ -47,8 +52,8 @@ class LTIFilter(Estimator):
     state is ``x_f(0) = C_F⁻¹ x̂(0)`` so that the first estimate is x̂(0).
     """
 
-    def __init__(self, A_F, B_F, C_F, system, measurement, *, name="lti", input_matrix=None, K=None):
-        super().__init__(system, measurement, name=name)
+    def __init__(self, A_F, B_F, C_F, system, measurement, *, name="lti", input_matrix=None, K=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         n = system.n
         self.A_F = as_matrix("A_F", A_F, (n, n))
         self.B_F = as_matrix("B_F", B_F, (n, measurement.n_meas))
@@ -81,13 +86,16 @@ class LTIFilter(Estimator):
     def n_input(self):
         return 0 if self._M is None else self._M.shape[1]
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         x0 = self._CF_inv @ np.asarray(xhat0, dtype=float)
         return FilterState(x=np.broadcast_to(x0, (runs, x0.size)).copy())
 
-    def update(self, state, y):
-        state.extra["y"] = np.asarray(y, dtype=float)
-        return state, StepOutput(xhat=state.x @ self.C_F.T)
+    def _update(self, state, y):
+        xhat = state.x @ self.C_F.T
+        if self.missing == "skip" and np.isnan(y).any():
+            y = np.where(np.isnan(y), self.measurement.function(xhat), y)  # the reading the filter predicts
+        state.extra["y"] = y
+        return state, StepOutput(xhat=xhat)
 
     def _drive(self, y, u):
         drive = y @ self.B_F.T
@@ -95,7 +103,7 @@ class LTIFilter(Estimator):
             drive = drive + u @ self._M.T
         return drive
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = state.x @ self._A_eff.T + self._drive(state.extra["y"], u)
@@ -105,7 +113,9 @@ class LTIFilter(Estimator):
         """Vectorized over runs and fast: same numbers as the step loop (bitwise)."""
         history_keys(keep_covariance, diagnostics)  # checked; the filter has neither a covariance nor diagnostics
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None)
+                                             self.n_input if self.uses_input else None, self.missing)
+        if np.isnan(y).any():  # missing readings are filled from the estimate, step by step
+            return super().estimate(y, u, xhat0, P0, keep_covariance=keep_covariance, diagnostics=diagnostics)
         runs, n1, _ = y.shape
         n = self.A_F.shape[0]
         drive = self._drive(y, u)

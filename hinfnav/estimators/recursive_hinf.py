@@ -39,7 +39,7 @@ from ..analysis.hinf_riccati import max_admissible_theta
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
+from .base import Estimator, FilterState, StepOutput
 
 __all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
 
@@ -76,6 +76,10 @@ class RecursiveHInfinityFilter(Estimator):
         :class:`~hinfnav.core.exceptions.InputError` naming θ (default), or
         set ``existence_ok`` False in the diagnostics and go on with the
         same formulas (P may then lose definiteness).
+    missing : {"refuse", "skip"}
+        A NaN channel: an InputError, or its innovation set to 0 (the reading
+        the filter predicts). The gain sequence does not depend on the data
+        and is kept (documented choice: P then assumes the channel was read).
     name : str
 
     Notes
@@ -88,8 +92,8 @@ class RecursiveHInfinityFilter(Estimator):
     name = "recursive_hinf"
 
     def __init__(self, system, measurement, *, theta, P0, Q=None, R=None, L=None, S=None, uses_input=True,
-                 on_violation="raise", name=None):
-        super().__init__(system, measurement, name=name)
+                 on_violation="raise", name=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         if not getattr(measurement, "linear", False) or measurement.H is None:
             raise InputError(f"measurement must be linear (y = H x + D v); got {type(measurement).__name__}")
         n, m = system.n, measurement.n_meas
@@ -161,7 +165,7 @@ class RecursiveHInfinityFilter(Estimator):
 
     # -- the step contract --------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
         x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
         return FilterState(x=x, P=P, extra={"steady": None})
@@ -177,11 +181,13 @@ class RecursiveHInfinityFilter(Estimator):
             P_next = P
         return K, P_next, margin, ok, steady
 
-    def update(self, state, y):
+    def _update(self, state, y):
         y = np.asarray(y, dtype=float)
         runs = state.x.shape[0]
         K, P_next, margin, ok, steady = self._gain(state.P, state.k, state.extra.get("steady"))
         innovation = y - state.x @ self.H.T
+        if self.missing == "skip":
+            innovation = np.where(np.isnan(innovation), 0.0, innovation)  # a missing channel: its predicted reading
         diag = {
             "innovation": innovation,
             "existence_margin": np.full(runs, margin),
@@ -191,7 +197,7 @@ class RecursiveHInfinityFilter(Estimator):
         new = FilterState(x=state.x, P=state.P, k=state.k, extra=extra)
         return new, StepOutput(xhat=state.x, P=np.broadcast_to(state.P, (runs,) + state.P.shape), diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         if "gain" not in state.extra:
@@ -202,51 +208,3 @@ class RecursiveHInfinityFilter(Estimator):
             x = x + np.asarray(u, dtype=float) @ self.Gamma.T
         extra = {"steady": state.extra.get("steady")}
         return FilterState(x=x, P=state.extra["P_next"], k=state.k + 1, extra=extra)
-
-    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
-        """Batch path: the (data-independent) gain sequence once, then all runs at once; same numbers as the steps."""
-        keys = history_keys(keep_covariance, diagnostics)
-        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None)
-        diagnostics = keys is None or bool(keys)
-        runs, n1, _ = y.shape
-        state = self.start(xhat0, P0, runs)
-        P, steady = state.P, None
-        P_hist = np.empty((n1,) + P.shape) if keep_covariance else None
-        margins, oks, FKs = np.empty(n1), np.empty(n1, dtype=bool), []
-        for k in range(n1):
-            if keep_covariance:
-                P_hist[k] = P
-            K, P, margins[k], oks[k], steady = self._gain(P, k, steady)
-            FKs.append(self.F @ K)
-            if steady is not None:  # the gain no longer changes: P_j = P_k for j > k
-                if keep_covariance:
-                    P_hist[k + 1:] = P
-                margins[k + 1:], oks[k + 1:] = margins[k], oks[k]
-                break
-        xhat = np.empty((runs, n1, self.n_state))
-        innov = np.empty(y.shape) if diagnostics else None
-        x = state.x
-        Ft, Ht, Gt = self.F.T, self.H.T, self.Gamma.T
-        for k in range(n1):
-            xhat[:, k] = x
-            e = y[:, k] - x @ Ht
-            if diagnostics:
-                innov[:, k] = e
-            if k < n1 - 1:
-                FK = FKs[min(k, len(FKs) - 1)]
-                x = x @ Ft + e @ FK.T
-                if self.uses_input:
-                    x = x + u[:, k] @ Gt
-        out_P = None
-        if keep_covariance:
-            P_hist.setflags(write=False)
-            out_P = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
-            if keep_covariance == "diagonal":
-                out_P = np.diagonal(out_P, axis1=-2, axis2=-1)
-        diag = {}
-        if diagnostics:
-            diag = {"innovation": innov, "existence_margin": np.broadcast_to(margins, (runs, n1)).copy(),
-                    "existence_ok": np.broadcast_to(oks, (runs, n1)).copy()}
-            diag = {key: val for key, val in diag.items() if keys is None or key in keys}
-        return EstimateHistory(xhat=xhat, P=out_P, state=self.system.state, diagnostics=diag)
