@@ -51,7 +51,7 @@ from hinfnav.analysis import (
 )
 from hinfnav.core.exceptions import InputError
 from hinfnav.estimators import ExtendedKalmanFilter
-from hinfnav.estimators.augmented import joseph_update
+from hinfnav.estimators.correction import joseph_update
 from hinfnav.estimators.base import FilterState
 from hinfnav.systems import LinearMeasurement, LinearSystem, StateSpec
 
@@ -145,9 +145,14 @@ def test_square_root_information_filter_three_steps(routine):
     kf = ExtendedKalmanFilter(system, LinearMeasurement(C, np.linalg.cholesky(R)), P0=np.linalg.inv(SINV.T @ SINV),
                               Q=B @ Q @ B.T, R=R, uses_input=True)
     y = np.linalg.solve(RINV, RINVY)
-    state = kf.start(X)
-    for _ in range(DATA[routine]["steps"]):
-        state, out = kf.update(kf.predict(state, u=-Z[None]), y[None])
+    # the example starts with a time update from X: the first prior, A X + B(−Z) and A P Aᵀ + B Q Bᵀ, is
+    # formed here (the step contract starts at a prior), then measurement and time updates alternate
+    P0 = np.linalg.inv(SINV.T @ SINV)
+    state = kf.start(A @ X - B @ Z, A @ P0 @ A.T + B @ Q @ B.T)
+    for i in range(DATA[routine]["steps"]):
+        if i:
+            state = kf.predict(state, u=-Z[None])
+        state, out = kf.update(state, y[None])
     np.testing.assert_allclose(out.xhat[0], _m(routine, "X_result"), rtol=0, atol=F84)
     # S⁻¹ is an upper Cholesky factor of the information matrix P(3|3)⁻¹, up to the signs of its rows
     S_inv = _m(routine, "SINV_result")

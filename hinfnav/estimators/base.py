@@ -44,7 +44,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_vector
 
-__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "history_keys",
+__all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
            "MISSING", "PHASES", "available_channels"]
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
@@ -57,6 +57,22 @@ def available_channels(y):
     """Mask of the finite channels of a reading ``y`` (runs, m), or None when every channel is there."""
     ok = ~np.isnan(y)
     return None if ok.all() else ok
+
+
+def fill_missing(measurement, y, x, yhat, mask):
+    """A reading with its missing channels replaced by the predicted ones, and the mask to apply.
+
+    ``yhat`` is the predicted output ``h(x̂⁻)``. A converted measurement (one with a ``sensor`` whose
+    readings it converts, e.g. range and angles to a position) has no meaning with part of a reading:
+    a run missing any channel misses the whole reading, which is replaced by the sensor's prediction.
+    """
+    if mask is None:
+        return y, None
+    sensor = getattr(measurement, "sensor", None)
+    if sensor is None or not hasattr(measurement, "convert"):
+        return np.where(mask, y, yhat), mask
+    whole = np.broadcast_to(mask.all(axis=1, keepdims=True), mask.shape)
+    return np.where(whole, y, sensor.function(x)), whole
 
 
 @dataclass

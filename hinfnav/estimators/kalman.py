@@ -28,7 +28,7 @@ import numpy as np
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
-from .base import Estimator, FilterState, StepOutput, available_channels
+from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
@@ -155,8 +155,8 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         try:
             H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
             yhat = self.measurement.function(x)
-            if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
-                y = np.where(mask, y, yhat)
+            # a missing channel reads as predicted (innovation 0; removed below)
+            y, mask = fill_missing(self.measurement, y, x, yhat, mask)
             innovation = self.measurement.residual(y, yhat)
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None

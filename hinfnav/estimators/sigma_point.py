@@ -56,7 +56,7 @@ from ..core.linalg import as_covariance, inv_spd
 from ..core.validation import as_choice, as_nonnegative, as_positive, as_real, as_vector
 from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
 from ..systems.state import StateSpec
-from .base import Estimator, FilterState, StepOutput
+from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 
 __all__ = ["RULES", "SigmaPointFilter", "merwe_weights", "sigma_points"]
@@ -120,8 +120,8 @@ class SigmaPointFilter(Estimator):
     name = "ukf"
 
     def __init__(self, system, measurement, *, P0, Q=None, R=None, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0,
-                 uses_input=False, output="filtered", name=None):
-        super().__init__(system, measurement, name=name)
+                 uses_input=False, output="filtered", name=None, missing="refuse"):
+        super().__init__(system, measurement, name=name, missing=missing)
         #: True for a state with its own error (a quaternion): sigma points in error coordinates (U6)
         self.error_coordinates = type(system.state).error is not StateSpec.error
         if self.error_coordinates:
@@ -202,23 +202,17 @@ class SigmaPointFilter(Estimator):
 
     # -- the step contract -------------------------------------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def _start(self, xhat0, P0, runs):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
         x = np.broadcast_to(as_vector("xhat0", xhat0, self.n_state), (runs, self.n_state)).copy()
         if self.error_coordinates:  # the system's injection of a zero correction normalises (a unit quaternion)
             x = self._inject(x, np.zeros((runs, self.n_cov)))
         return FilterState(x=x, P=np.broadcast_to(P, (runs,) + P.shape).copy())
 
-    def update(self, state, y):
+    def _update(self, state, y):
         x, P = state.x, state.P
         runs, n = x.shape
-        if state.extra.get("updated"):
-            raise InputError(f"filter {self.name!r}: update called twice at step {state.k}; call predict between updates")
-        y = np.asarray(y, dtype=float)
-        if y.shape != (runs, self.measurement.n_meas) or not np.all(np.isfinite(y)):
-            raise InputError(f"y at step {state.k} must be finite numbers of shape ({runs}, {self.measurement.n_meas}) "
-                             f"(runs, n_meas); got shape {y.shape}" + ("" if y.size == 0 or np.all(np.isfinite(y))
-                                                                       else " with NaN or inf entries"))
+        mask = available_channels(y) if self.missing == "skip" else None
         dX = self._points(P, state.k, "prior")
         X = self._inject(x[:, None, :], dX)
         N = X.shape[1]
@@ -233,21 +227,34 @@ class SigmaPointFilter(Estimator):
         diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
         y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
         dY = diff(Y, y_mean[:, None, :])
+        y, mask = fill_missing(self.measurement, y, x, y_mean, mask)  # a missing channel reads as predicted
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
+        innovation = self.measurement.residual(y, y_mean)
+        if mask is not None:
+            # the channel removed exactly, as drop_missing does for the Kalman correction: its output
+            # deviations and innovation zeroed, its rows and columns of R decoupled (S block diagonal, K's
+            # column 0), so the rest of the update is the filter's without that channel
+            if self.R_of_reading is not None:  # R(y) not finite on the channels it has: the reading is not used
+                both = mask[:, :, None] & mask[:, None, :]
+                mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
+            dY = np.where(mask[:, None, :], dY, 0.0)
+            both = mask[:, :, None] & mask[:, None, :]
+            R_k = np.where(both, R_k, 0.0) + np.eye(R_k.shape[-1]) * ~mask[:, None, :]
+            innovation = np.where(mask, innovation, 0.0)
         S = self._cov(dY, dY) + R_k
         Pxy = self._cov(dX, dY)
         K = Pxy @ inv_spd(S)
-        innovation = self.measurement.residual(y, y_mean)
         x_post = self._inject(x, (K @ innovation[:, :, None])[:, :, 0])
         P_post = P - K @ S @ np.swapaxes(K, -1, -2)
         P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
-        diag = {"innovation": innovation, "innovation_covariance": S}
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, updated=True))
+        diag = {"innovation": innovation if mask is None else np.where(mask, innovation, np.nan),
+                "innovation_covariance": S}
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra))
         if self.output == "filtered":
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         runs, n = state.x.shape
@@ -256,10 +263,6 @@ class SigmaPointFilter(Estimator):
         uu = None
         if self.uses_input:
             u = np.asarray(u, dtype=float)
-            if u.shape != (runs, self.n_input) or not np.all(np.isfinite(u)):
-                raise InputError(f"u at step {state.k} must be finite numbers of shape ({runs}, {self.n_input}) "
-                                 f"(runs, n_input); got shape {u.shape}" + ("" if np.all(np.isfinite(u))
-                                                                            else " with NaN or inf entries"))
             uu = np.repeat(u, N, axis=0)
         t = state.k * self.dt
         Xf = self._propagate(X.reshape(runs * N, n), uu, t).reshape(runs, N, n)
@@ -271,5 +274,4 @@ class SigmaPointFilter(Estimator):
             mean = self.Wm @ D
             x, dX = self._inject(ref, mean), D - mean[:, None, :]
         P = self._cov(dX, dX) + self.Q
-        extra = {key: val for key, val in state.extra.items() if key != "updated"}
-        return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
+        return FilterState(x=x, P=P, k=state.k + 1, extra=dict(state.extra))
