@@ -177,7 +177,7 @@ class MixtureNoise(NoiseModel):
         return 1.0 / np.sqrt((1 - self.eps) + self.eps * self.ratio**2)
 
     @property
-    def kurtosis(self):  # noqa: D401 - property overriding a class attribute
+    def kurtosis(self):
         """Theoretical kurtosis."""
         e, r = self.eps, self.ratio
         return 3 * ((1 - e) + e * r**4) / ((1 - e) + e * r**2) ** 2
@@ -225,7 +225,7 @@ class StudentTNoise(NoiseModel):
         as_int_at_least("dof", self.dof, 5)
 
     @property
-    def kurtosis(self):  # noqa: D401
+    def kurtosis(self):
         """Theoretical kurtosis."""
         return 3.0 + 6.0 / (self.dof - 4)
 

@@ -15,7 +15,7 @@ import pytest
 from scipy.stats import chi2
 
 import hinfnav
-import hinfnav.papers  # noqa: F401 - registers the papers' scenarios and estimators
+import hinfnav.papers
 from hinfnav.campaign import Campaign, run_campaign
 from hinfnav.cli import main
 from hinfnav.core.exceptions import FilterDivergenceWarning, InputError

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import hinfnav as hn
-import hinfnav.papers  # noqa: F401 - registers every paper's estimators, whatever the test order
+import hinfnav.papers
 from hinfnav.estimators import build_estimator, registered_estimators
 from hinfnav.noise import NoiseModel
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario

@@ -90,7 +90,7 @@ def test_huber_on_the_attitude_filter_downweights_a_bad_star_vector(truth):
     assert np.all(np.isfinite(hist.xhat))
     assert hist.diagnostics["weights"][0, 20, 0] < 0.1
     plain = _attitude(AttitudeAEKF, truth, y=y)
-    err = lambda h: np.abs(h.xhat[0, 21, :4] - truth.x[0, 21, :4]).max()  # noqa: E731
+    err = lambda h: np.abs(h.xhat[0, 21, :4] - truth.x[0, 21, :4]).max()
     assert err(hist) < err(plain)
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import hinfnav as hn
-import hinfnav.papers.shi2018  # noqa: F401  (registers "hbf" and "ekf_converted")
+import hinfnav.papers.shi2018
 from hinfnav.core import InputError
 from hinfnav.estimators import ExtendedKalmanFilter, HuberFilter, build_estimator, huber_update, registered_estimators
 from hinfnav.papers import sun2011

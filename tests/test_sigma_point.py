@@ -18,7 +18,7 @@ from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
 from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
 import hinfnav as hn
-import hinfnav.papers  # noqa: F401 - registers every paper's estimators
+import hinfnav.papers
 from hinfnav.core.exceptions import HinfnavError, InputError
 from hinfnav.estimators import (
     ExtendedKalmanFilter,

@@ -181,7 +181,7 @@ def brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, lib):
         [Z((nout, N)), Cbar, Z((nout, nin)), -np.eye(nout)],
     ]
     if Hbar is not None:
-        r1, r2 = Hbar.shape[1], Ebar.shape[0]
+        r1 = Hbar.shape[1]
         rows[1][1] = -P + lam * (Ebar.T @ Ebar)
         extra = [P @ Hbar, Z((N, r1)), Z((nin, r1)), Z((nout, r1))]
         for row, blk in zip(rows, extra):

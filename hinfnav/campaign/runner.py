@@ -144,7 +144,7 @@ def run_unit(unit):
             estimators[c["cell_id"]] = _estimator(scenario, unit["scenario"], unit["settings"], c["estimator"],
                                                   c["options"])
             accs[c["cell_id"]] = CellAccumulator(unit["windows"], runs, unit["tol"])
-        except Exception as exc:  # noqa: BLE001 - reported per cell, the campaign goes on
+        except Exception as exc:
             errors[c["cell_id"]] = f"{type(exc).__name__}: {exc}"
         elapsed[c["cell_id"]] += time.perf_counter() - t0
         cpu[c["cell_id"]] += time.process_time() - c0
@@ -164,7 +164,7 @@ def run_unit(unit):
                 est = estimators[cid]
                 check_measurement_match(est, truth.measurement)
                 _run_cell_batch(est, truth, scenario.xhat0, accs[cid], start)
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:
                 errors[cid] = f"{type(exc).__name__}: {exc}"
             elapsed[cid] += time.perf_counter() - t0
             cpu[cid] += time.process_time() - c0
@@ -290,7 +290,7 @@ def _close(dask_client):
 
 def _differences(old, new):
     """Fields in which two spec dicts (``Campaign.as_dict``) differ, as ``field: old → new`` strings."""
-    same = lambda a, b: canonical(a) == canonical(b)  # noqa: E731 - 1 and 1.0 are one value
+    same = lambda a, b: canonical(a) == canonical(b)
     out = []
     for key in sorted(set(old) | set(new)):
         a, b = old.get(key), new.get(key)

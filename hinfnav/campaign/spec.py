@@ -208,7 +208,7 @@ class Campaign:
     name: str = "campaign"
 
     def __post_init__(self):
-        set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        set_ = lambda k, v: object.__setattr__(self, k, v)
         for key, minimum in (("runs", 1), ("seed", 0), ("batch_size", 1)):
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, numbers.Integral):

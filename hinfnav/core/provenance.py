@@ -34,7 +34,7 @@ def package_version():
             from setuptools_scm import get_version  # optional at run time; the build uses it
 
             return get_version(root=str(root), version_scheme="guess-next-dev", local_scheme="node-and-date")
-        except Exception:  # noqa: BLE001 - no setuptools-scm, no git, a shallow clone: fall back to metadata
+        except Exception:
             pass
     try:
         return metadata.version("hinfnav")
@@ -75,7 +75,7 @@ def provenance(**extra):
     out = {
         "hinfnav": package_version(),
         "commit": git_commit(),
-        "date_utc": datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat(),
+        "date_utc": datetime.datetime.now(datetime.UTC).replace(microsecond=0).isoformat(),
         "python": platform.python_version(),
         "libraries": libs,
     }

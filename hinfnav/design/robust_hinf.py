@@ -345,8 +345,7 @@ def synthesize(
         raise InputError("give either solver or options (SolverOptions(solvers=...)), not both")
     elif not isinstance(options, SolverOptions):
         raise InputError(f"options must be a hinfnav.SolverOptions; got {type(options).__name__}")
-    method, margin, accuracy, rtol = options.method, options.margin, options.accuracy, options.rtol
-    max_bisection, polish = options.max_bisection, options.polish
+    method, polish = options.method, options.polish
     if not isinstance(form, str):
         raise InputError(f"form must be a string, one of {', '.join(FORMS)}; got {form!r}")
     form = as_choice("form", form, FORMS)

@@ -92,8 +92,6 @@ def hinf_gamma_index(N, k):
 def filter_slack_products(vertex, X, Z, V, Ahat, Bhat, CF, bmat=np.block):
     """``G Ā``, ``G B̄``, ``C̄`` of the general form at one vertex ``(A, B, C, D, L)`` (see the module docstring)."""
     A, B, C, D, L = vertex
-    n, p = B.shape
-    q = D.shape[1]
     GA = bmat([[X @ A + Bhat @ C, Ahat], [Z @ A + Bhat @ C, Ahat]])
     GB = bmat([[X @ B, Bhat @ D], [Z @ B, Bhat @ D]])
     Cbar = bmat([[L, -CF]])

@@ -243,7 +243,7 @@ def _solve_once(P, solver, margin, accuracy, gamma2, bound):
     status = str(prob.status)
     if X.value is None or S.value is None:
         return Solution(status, float("nan"), seconds=seconds)
-    sym = lambda Y: 0.5 * (Y + Y.T)  # noqa: E731
+    sym = lambda Y: 0.5 * (Y + Y.T)
     S_val = sym(S.value)
     if observer:
         R_val = S_val + sym(X.value)

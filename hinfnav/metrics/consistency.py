@@ -350,7 +350,7 @@ class ConsistencyStatistics:
             Name → (start, end), s.
         """
         diverged, reasons = self.divergence(windows.values())
-        lo_hi = lambda b: None if b is None else list(b)  # noqa: E731
+        lo_hi = lambda b: None if b is None else list(b)
         return {"nees_dof": self.n if self.nees is not None else None, "nis_dof": self.m if self.nis is not None else None,
                 "nees_bounds": lo_hi(self.nees_bounds), "nis_bounds": lo_hi(self.nis_bounds),
                 "windows": {name: self.window(w) for name, w in windows.items()},

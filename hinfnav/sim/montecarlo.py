@@ -247,7 +247,7 @@ def simulate(scenario, estimator, *, noise="gaussian", measurement_noise=None, r
         res = parts[0]
         res.settings["runs"] = runs
         return res
-    cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
+    cat = lambda name: np.concatenate([getattr(p, name) for p in parts])
     P = _concat_covariances([p.P for p in parts], runs)
     settings = dict(parts[0].settings, runs=runs)
     diag = {k: np.concatenate([p.diagnostics[k] for p in parts]) for k in parts[0].diagnostics}

@@ -65,6 +65,6 @@ def cell_kalman_limit(scenario, *, maneuver, delta=0.0, discretization="exact"):
     A = Phi + Gamma @ scenario.K if maneuver else Phi
     P, Pf, _ = steady_state_kalman(A, measurement_matrix(), scenario.B @ scenario.B.T, scenario.D @ scenario.D.T)
     sf, sp = np.sqrt(np.diag(Pf)), np.sqrt(np.diag(P))
-    rms = lambda s: float(np.sqrt(np.mean(s ** 2)))  # noqa: E731
+    rms = lambda s: float(np.sqrt(np.mean(s ** 2)))
     return {"pos_m": rms(sf[:3]), "vel_mps": rms(sf[3:]), "pos_m_predicted": rms(sp[:3]),
             "vel_mps_predicted": rms(sp[3:]), "pos_axes_m": sf[:3].tolist(), "vel_axes_mps": sf[3:].tolist()}

@@ -45,7 +45,7 @@ MEASUREMENTS = ("converted", "direct")
 HBF_BASES = ("ekf_known_input", "ekf")
 
 
-def EKF(scenario, *, measurement="converted", sigma_range=None, sigma_angle=None, Q=None, P0=None,  # noqa: N802
+def EKF(scenario, *, measurement="converted", sigma_range=None, sigma_angle=None, Q=None, P0=None,
         output="filtered", name=None):
     """The EKF of Shi & Wang (2018) on :class:`~hinfnav.papers.shi2018.Scenario`.
 
@@ -81,7 +81,7 @@ def EKF(scenario, *, measurement="converted", sigma_range=None, sigma_angle=None
                                 uses_input=True, output=output, name=name)
 
 
-def HBF(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, name=None, **ekf_options):  # noqa: N802
+def HBF(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, name=None, **ekf_options):
     """The Huber-based filter of Shi & Wang (2018): :func:`EKF` with the Huber update.
 
     Parameters

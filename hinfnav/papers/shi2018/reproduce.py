@@ -109,7 +109,7 @@ def verdicts(summary):
         r["hbf"]["peak_pos_bias_m"])
     smoother = jit["pos_ci95_m"][1] < 0 and jit["vel_ci95_mps"][1] < 0
     final_better = fin["pos_ci95_m"][1] < 0
-    yes = lambda flag: "yes" if flag else "no"  # noqa: E731
+    yes = lambda flag: "yes" if flag else "no"
     out["maneuver"] = {
         "ekf_faster": bool(faster), "hbf_smoother": bool(smoother), "hbf_final_more_accurate": bool(final_better),
         "reproduced": bool(faster and smoother and final_better),

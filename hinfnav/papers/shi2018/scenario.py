@@ -43,8 +43,6 @@ from .constants import (
     INITIAL_ESTIMATE_ERROR,
     MANEUVER_DV_MPS,
     MANEUVER_TIME_S,
-    MIXTURE_EPS,
-    MIXTURE_RATIO,
     ORBITAL_RATE,
     P0_STD,
     WINDOW_S,
@@ -137,7 +135,7 @@ class Scenario:
     window_s: tuple = WINDOW_S
 
     def __post_init__(self):
-        set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        set_ = lambda k, v: object.__setattr__(self, k, v)
         for name in ("n", "dt", "duration_s", "sigma_range", "sigma_angle", "sigma_accel"):
             set_(name, as_positive(name, getattr(self, name)))
         if self.duration_s < self.dt:

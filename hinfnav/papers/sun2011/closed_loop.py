@@ -162,7 +162,7 @@ def plot_closed_loop(study, *, axes=None, run=0):
         fig, grid = new_figure(1, 3, figsize=(12, 3.6))
         axes = grid[0]
     fig = axes[0].figure
-    for i, (key, res) in enumerate(study.results.items()):
+    for i, res in enumerate(study.results.values()):
         label = study.rows[i]["label"].split(", ", 1)[-1]  # drop "u = K x̂, " (x̂ is two code points)
         r = np.linalg.norm(res.state.select(res.x[run], "position"), axis=-1)
         axes[0].semilogy(res.t, np.maximum(r, 1e-3), lw=1, label=label)

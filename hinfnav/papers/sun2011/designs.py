@@ -514,5 +514,5 @@ def small_gain_crossing(scenario=None, bracket=(0.5, 5.0)):
     Root of ``small_gain_bounds([δ̄])["printed"] − 1`` by Brent's method in
     ``bracket`` (to 1e-6 in δ̄).
     """
-    f = lambda d: small_gain_bounds([d], scenario)["printed"][0] - 1.0  # noqa: E731
+    f = lambda d: small_gain_bounds([d], scenario)["printed"][0] - 1.0
     return float(scipy.optimize.brentq(f, *bracket, xtol=1e-6))

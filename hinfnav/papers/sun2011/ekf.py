@@ -71,7 +71,7 @@ MEASUREMENT_MODELS = ("position", "range_angles")
 DYNAMICS_MODELS = ("unforced", "applied_thrust", "control_law")
 
 
-def EKF(  # noqa: N802 - kept as the name users know
+def EKF(
     scenario,
     *,
     measurement="position",

@@ -78,7 +78,7 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default"):
     fig, axes = new_figure(len(state.groups), max(len(i) for i in state.groups.values()), figsize=FIGURE_SIZES[size])
     m = result.t >= t_zoom_from
     err = result.error[run][m]
-    lim = lambda a: 1.15 * max(np.max(np.abs(a)), 1e-6)  # noqa: E731
+    lim = lambda a: 1.15 * max(np.max(np.abs(a)), 1e-6)
     ylims = {g: (-lim(state.select(err, g)), lim(state.select(err, g))) for g in state.groups}
     plot_errors(result, axes=axes, run=run, ylims=ylims, title=title)
     if t_zoom_from > result.t[0]:

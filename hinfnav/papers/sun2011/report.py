@@ -81,7 +81,7 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
                                    progress=progress, maneuver=maneuver, delta=delta, discretization=discretization)
     w, st = stats["main"], stats.state
     P, V = list(st.indices("position")), list(st.indices("velocity"))
-    r = lambda a: [float(v) if np.isfinite(v) else None for v in np.asarray(a)]  # noqa: E731 (no interval: None)
+    r = lambda a: [float(v) if np.isfinite(v) else None for v in np.asarray(a)]
     cell_p, cell_v = _axes_rms(w.per_run[:, P]), _axes_rms(w.per_run[:, V])
 
     def mc(vals):

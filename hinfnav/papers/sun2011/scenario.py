@@ -91,7 +91,7 @@ class Scenario:
     rms_window_s: tuple = (100.0, 1000.0)
 
     def __post_init__(self):
-        set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
+        set_ = lambda k, v: object.__setattr__(self, k, v)
         set_("omega0", as_positive("omega0", self.omega0))
         set_("mass", as_positive("mass", self.mass))
         set_("dt", as_positive("dt", self.dt))

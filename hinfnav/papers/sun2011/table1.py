@@ -350,7 +350,7 @@ def format_table1(tab, markdown=False):
     rows = table1_rows(tab)
     runs = tab.settings.get("runs")
     notes = [r for r in rows if "note" in r]
-    mark = lambda r: f" [{notes.index(r) + 1}]" if r in notes else ""  # noqa: E731
+    mark = lambda r: f" [{notes.index(r) + 1}]" if r in notes else ""
     if markdown:
         head = ["case", "filter", "pos (m), 1 run", "vel (m/s), 1 run", f"pos (m), mean of {runs} [95% CI]",
                 f"vel (m/s), mean of {runs} [95% CI]", "reproduce with"]
@@ -370,7 +370,7 @@ def format_table1(tab, markdown=False):
         mc_v = _pm(r["mc_vel_mps"], r["mc_vel_ci95"]) if "mc_vel_mps" in r else ""
         body.append([r["case"], SHORT_LABELS[r["key"]] + mark(r), _fmt(r["pos_m"]), _fmt(r["vel_mps"]), mc_p, mc_v])
     widths = [max(len(str(x)) for x in col) for col in zip(head, *body)]
-    fmt = lambda cells: "  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip()  # noqa: E731
+    fmt = lambda cells: "  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip()
     out = [fmt(head), fmt(["-" * w for w in widths])] + [fmt(b) for b in body]
     out += [f"[{i + 1}] {r['note']}" for i, r in enumerate(notes)]
     return "\n".join(_wrap(line, 100) for line in out)
