@@ -84,7 +84,8 @@ class NonlinearPredictionEKF(ExtendedKalmanFilter):
         self.chief = chief
         self._f = pair(MODELS[model])
 
-    def predict(self, state, u=None):
+    def _predict(self, state, u):
+        """The step contract's prediction hook: the mean through the nonlinear pair model, P through Φ."""
         k = state.k
         r_c, v_c = self.chief[0][k], self.chief[1][k]
         r_d, v_d = hill_to_inertial(r_c, v_c, state.x)
