@@ -12,7 +12,7 @@ from .extended_state import ExtendedStateKalmanFilter, FusedExtendedStateFilter,
 from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
 from .huber_filter import HuberCorrection, HuberFilter
 from .recursive_hinf import RecursiveHInfinityFilter
-from .kalman import OUTPUTS, ExtendedKalmanFilter
+from .kalman import OUTPUTS, ExtendedKalmanFilter, StrongTrackingEKF
 from .lti import LTIFilter
 from .sigma_point import SigmaPointFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -41,6 +41,7 @@ __all__ = [
     "RecursiveHInfinityFilter",
     "SigmaPointFilter",
     "StrongTracking",
+    "StrongTrackingEKF",
     "RateAdaptive",
     "AugmentedEKF",
     "AugmentedInputKF",

@@ -1,8 +1,11 @@
 """The two ideas of paper 002 as small hooks on one EKF: strong tracking and rate-adapted noise.
 
-Both act on an :class:`~hinfnav.estimators.augmented.AugmentedEKF` (an EKF
-whose last error coordinates are random-walk augmented states) by overriding
-one hook each.
+Both override one hook each. Strong tracking (hook ``complete_prior``) acts
+on either Kalman core: :class:`~hinfnav.estimators.ExtendedKalmanFilter` (a
+linear system or any dynamics model, e.g. a constant-turn target) and
+:class:`~hinfnav.estimators.augmented.AugmentedEKF` (an EKF whose last error
+coordinates are random-walk augmented states). Rate-adapted noise (hook
+``process_noise``) needs augmented states, so it acts on the augmented core.
 
 **Strong tracking** (suboptimal multiple fading factors; Zhou, Xi & Zhang,
 Acta Automatica Sinica 17(6), 1991, rebuilt there from; paper 002 §2.3):
@@ -162,8 +165,9 @@ def _check_beta(name, value):
 class StrongTracking:
     """Mixin: strong tracking by multiple fading factors (S1)–(S4).
 
-    Put it before an :class:`~hinfnav.estimators.augmented.AugmentedEKF`
-    subclass in the bases. Keyword parameters (besides the host's):
+    Put it before an :class:`~hinfnav.estimators.ExtendedKalmanFilter` or
+    :class:`~hinfnav.estimators.augmented.AugmentedEKF` (sub)class in the
+    bases; the host needs a constant R. Keyword parameters (besides the host's):
 
     Parameters
     ----------
@@ -181,9 +185,12 @@ class StrongTracking:
     """
 
     data_dependent_covariance = True
+    defers_prior = True
 
     def __init__(self, *args, rho=0.95, beta=1.0, a=None, **kwargs):
         super().__init__(*args, **kwargs)
+        if getattr(self, "R", None) is None:
+            raise InputError("strong tracking needs a constant R (N of (S2) subtracts β R); give R to the filter")
         self.rho = per_run_parameter("rho", rho, _check_rho)
         self.beta = per_run_parameter("beta", beta, _check_beta)
         a = np.ones(self.n_cov) if a is None else np.asarray(a, dtype=float)
@@ -191,7 +198,7 @@ class StrongTracking:
             raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
         self.a = a
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
         """(S1)-(S4). With missing channels (``~mask``; innovation and H zero there) the moment and N use the
         channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
         V0_old = state.extra.get("V0")
@@ -212,6 +219,13 @@ class StrongTracking:
             lam = np.where(gone[:, None], 1.0, lam)
         P = fade(PhiPPhiT, lam) + Qd
         return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
+
+    def _start(self, xhat0, P0, runs):
+        for key in ("rho", "beta"):
+            val = getattr(self, key)
+            if isinstance(val, np.ndarray) and val.size != runs:
+                raise InputError(f"runs must equal the number of per-run values of {key} ({val.size}); got {runs}")
+        return super()._start(xhat0, P0, runs)
 
     def initial_diagnostics(self, runs):
         out = super().initial_diagnostics(runs)

@@ -14,7 +14,9 @@ coordinates are augmented states β with ``β̇ = n_β``, E[n_β n_βᵀ] = Q δ
 A subclass supplies the model (hooks ``initial_internal``, ``propagate_mean``,
 ``transition``, ``observe``, ``inject``, ``report``, ``report_covariance``,
 ``augmented``); the ideas of :mod:`hinfnav.estimators.adaptive` override
-``predict_covariance`` (strong tracking) or ``process_noise`` (adaptive).
+``complete_prior`` (strong tracking; the same hook as on
+:class:`~hinfnav.estimators.ExtendedKalmanFilter`) or ``process_noise``
+(adaptive).
 
 :class:`AugmentedInputKF` wraps a :class:`~hinfnav.systems.LinearSystem`
 ``x(k+1) = Φ x + Γ u + B w`` whose input u is *unknown* to the filter and is
@@ -157,7 +159,7 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
         return self.Qd, {}
 
-    def predict_covariance(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
         """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1).
 
         ``innovation`` and ``H`` are zero on the channels ``~mask`` a reading lacks (mask None: none).
@@ -205,8 +207,8 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         diag.update(self.step_diagnostics(state))
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         if "PhiPPhiT" in state.extra:
-            P, d_hook, e_hook = self.predict_covariance(state.extra["PhiPPhiT"], state.extra["Qd"], state, used, H,
-                                                        mask=mask)
+            P, d_hook, e_hook = self.complete_prior(state.extra["PhiPPhiT"], state.extra["Qd"], state, used, H,
+                                                    mask=mask)
             diag.update(d_hook)
             extra.update(e_hook)
         else:

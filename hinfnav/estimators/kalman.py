@@ -6,8 +6,14 @@ or any dynamics model (``n``, ``n_input``, ``dt``, ``state``, ``Q``,
 x̂(k|k) propagates P) and linearizes the measurement model at the prior estimate. It is one
 class with small hooks that the variants override:
 
-* :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``
-  (strong tracking multiplies by fading factors);
+* :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``;
+* :meth:`~ExtendedKalmanFilter.process_noise` and
+  :meth:`~ExtendedKalmanFilter.complete_prior` — the hooks shared with
+  :class:`~hinfnav.estimators.AugmentedEKF`: a filter whose class sets
+  ``defers_prior`` keeps ``F P Fᵀ`` and ``Q`` from ``predict`` and completes
+  P(k+1|k) when y(k+1) arrives, so the mixins of
+  :mod:`hinfnav.estimators.adaptive` (strong tracking) work on both cores,
+  on a linear system or any dynamics model;
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
 * :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
@@ -28,13 +34,17 @@ import numpy as np
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
+from .adaptive import StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 
-__all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
+__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "StrongTrackingEKF"]
 
 #: What ``update`` reports at t_k: x̂(k|k) or x̂(k|k−1).
 OUTPUTS = ("filtered", "predicted")
+
+#: Keys of ``FilterState.extra`` that live from one step to the next only.
+_TRANSIENT = ("prior", "PhiPPhiT", "Qd")
 
 
 class ExtendedKalmanFilter(KalmanCorrection, Estimator):
@@ -69,6 +79,10 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
 
     name = "ekf"
     symmetric_posterior = False
+    #: True when the covariance depends on the data (a mixin's Huber weights, fading factors …)
+    data_dependent_covariance = False
+    #: True when P(k+1|k) is completed at the next reading (:meth:`complete_prior`), e.g. by strong tracking
+    defers_prior = False
 
     def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
                  missing="refuse"):
@@ -102,7 +116,13 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     @property
     def shares_covariance(self):
         """True when P and the gain do not depend on the data (linear measurement, constant R)."""
-        return bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
+        return (bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
+                and not self.data_dependent_covariance)
+
+    @property
+    def n_cov(self):
+        """Dimension of the error coordinates (and of P): the state's here."""
+        return self.n_state
 
     # -- hooks ------------------------------------------------------------------
 
@@ -117,10 +137,31 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
 
     def predict_covariance(self, P, state, F=None):
         """``F P Fᵀ + Q`` with F = Φ, or the dynamics model's Jacobian at x̂(k|k) ((n, n) or (runs, n, n))."""
+        return self.propagated_covariance(P, F) + self.Q
+
+    def propagated_covariance(self, P, F=None):
+        """``F P Fᵀ`` without the process noise (F = Φ, or the dynamics model's Jacobian, (runs, n, n))."""
         F = self.F if F is None else F
         if F.ndim == 3:
-            return F @ P @ np.swapaxes(F, -1, -2) + self.Q
-        return congruence(F, P) + self.Q
+            return F @ P @ np.swapaxes(F, -1, -2)
+        return congruence(F, P)
+
+    def process_noise(self, state):
+        """``(Q_d, extra)``: the process noise of the step from ``state`` (constant :attr:`Q` here)."""
+        return self.Q, {}
+
+    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """``(P(k+1|k), diagnostics, extra)`` at the reading y(k+1): ``F P Fᵀ + Q_d`` here.
+
+        Called only when :attr:`defers_prior` is set; ``innovation`` and ``H``
+        are zero on the channels ``~mask`` a reading lacks (mask None: none).
+        Strong tracking (:class:`~hinfnav.estimators.adaptive.StrongTracking`) overrides it.
+        """
+        return PhiPPhiT + Qd, {}, {}
+
+    def initial_diagnostics(self, runs):
+        """Diagnostics every step reports, at their values before any prediction (none here)."""
+        return {}
 
     def measurement_covariance(self, y, x):
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
@@ -161,6 +202,14 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         R_k = self.measurement_covariance(y, x)
+        extra = state.extra
+        diag_prior = self.initial_diagnostics(x.shape[0])
+        if "PhiPPhiT" in extra:  # a deferred prior (defers_prior): completed with this reading
+            _, H_0, _, used_0 = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+            P, d_hook, e_hook = self.complete_prior(extra["PhiPPhiT"], extra["Qd"], state, used_0, H_0, mask=mask)
+            diag_prior.update(d_hook)
+            extra = {key: val for key, val in extra.items() if key not in _TRANSIENT}
+            extra.update(e_hook)
         if mask is None:
             x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
         else:
@@ -169,8 +218,8 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
                 mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
             P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
             x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
-        diag = dict(diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra, prior=(x, P)))
+        diag = dict(diag_prior, **diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(extra, prior=(x, P)))
         if self.output == "filtered":
             out = StepOutput(xhat=x_post, P=self._broadcast(P_post, x.shape[0]), diagnostics=diag)
         else:
@@ -180,16 +229,36 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
+        F = None
         if self.nonlinear_dynamics:  # the Jacobian at the posterior x̂(k|k), before the mean moves on
             t = state.k * self.dt
             F = np.asarray(self.system.jacobian(state.x, u if self.uses_input else None, t), dtype=float)
-            P = self.predict_covariance(state.P, state, F=F)
             x = self.predict_mean(state.x, u, t)
         else:
             x = self.predict_mean(state.x, u)
+        extra = {key: val for key, val in state.extra.items() if key not in _TRANSIENT}
+        if self.defers_prior:  # F P Fᵀ and Q_d kept for complete_prior at the next reading
+            PhiPPhiT = self.propagated_covariance(state.P, F)
+            Qd, e_noise = self.process_noise(state)
+            extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
+            P = PhiPPhiT + Qd
+        elif F is not None:
+            P = self.predict_covariance(state.P, state, F=F)
+        else:
             P = self.predict_covariance(state.P, state)
-        extra = {key: val for key, val in state.extra.items() if key != "prior"}
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
     def _broadcast(self, P, runs):
         return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P
+
+
+class StrongTrackingEKF(StrongTracking, ExtendedKalmanFilter):
+    """Strong-tracking EKF: :class:`ExtendedKalmanFilter` with multiple fading factors.
+
+    On a linear system or any dynamics model; parameters of
+    :class:`ExtendedKalmanFilter` and ``rho``, ``beta``, ``a`` of
+    :class:`~hinfnav.estimators.adaptive.StrongTracking` ((S1)–(S4); R must
+    be constant). Diagnostics ``fading`` (runs, n) and ``fading_c`` (runs,).
+    """
+
+    name = "stekf"
