@@ -12,7 +12,7 @@ from .extended_state import ExtendedStateKalmanFilter, FusedExtendedStateFilter,
 from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
 from .huber_filter import HuberCorrection, HuberFilter
 from .recursive_hinf import RecursiveHInfinityFilter
-from .kalman import OUTPUTS, ExtendedKalmanFilter, StrongTrackingEKF
+from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, StrongTrackingEKF
 from .lti import LTIFilter
 from .sigma_point import SigmaPointFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -29,6 +29,7 @@ __all__ = [
     "huber_update",
     "HuberUpdate",
     "HuberFilter",
+    "KalmanCore",
     "HuberCorrection",
     "KalmanCorrection",
     "joseph_update",

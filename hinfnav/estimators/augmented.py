@@ -11,6 +11,10 @@ coordinates are augmented states β with ``β̇ = n_β``, E[n_β n_βᵀ] = Q δ
 * update (Joseph form) ``K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹``, ``δx = K γ``,
   ``P = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ``, x̂ ← inject(x̂⁻, δx)   (E2).
 
+It is a :class:`~hinfnav.estimators.kalman.KalmanCore`: the update (E2),
+the deferred prior, the missing channels and the report are the core's one
+``_update``, shared with :class:`~hinfnav.estimators.ExtendedKalmanFilter`;
+this class supplies the prediction (E1) in error coordinates.
 A subclass supplies the model (hooks ``initial_internal``, ``propagate_mean``,
 ``transition``, ``observe``, ``inject``, ``report``, ``report_covariance``,
 ``augmented``); the ideas of :mod:`hinfnav.estimators.adaptive` override
@@ -29,23 +33,22 @@ its covariance is shared by every run.
 
 import numpy as np
 
-from ..core.exceptions import HinfnavError, InputError
+from ..core.exceptions import InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
-from .base import Estimator, FilterState, StepOutput, available_channels
-from .correction import KalmanCorrection, drop_missing
+from .base import FilterState
 from .huber_filter import HuberCorrection
-from .kalman import OUTPUTS
+from .kalman import OUTPUTS, KalmanCore
 
 __all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputHuberSTKF", "AugmentedInputKF",
            "AugmentedInputSTKF"]
 
 #: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
-_TRANSIENT = ("PhiPPhiT", "Qd", "q_used", "kappa_used")
+_TRANSIENT = ("prior", "PhiPPhiT", "Qd", "q_used", "kappa_used")
 
 
-class AugmentedEKF(KalmanCorrection, Estimator):
+class AugmentedEKF(KalmanCore):
     """EKF in error coordinates with augmented random-walk states (E1)–(E2); see the module docstring.
 
     Parameters
@@ -75,8 +78,10 @@ class AugmentedEKF(KalmanCorrection, Estimator):
     """
 
     name = "augmented ekf"
-    data_dependent_covariance = False
     linear_model = False
+    defers_prior = True
+    refuse_nonfinite = True
+    transient_keys = _TRANSIENT
 
     def __init__(self, system, measurement, *, n_cov, aug_input, P0, Q, base_noise=None, R=None, uses_input=False,
                  output="filtered", name=None, missing="refuse"):
@@ -133,10 +138,6 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         """Φ of the error coordinates at the posterior, (n_cov, n_cov) or (runs, n_cov, n_cov)."""
         raise NotImplementedError
 
-    def observe(self, x):
-        """``(ŷ, H)`` at the prior: ŷ (runs, m), H (m, n_cov) or (runs, m, n_cov)."""
-        raise NotImplementedError
-
     def inject(self, x, dx):
         """The internal state corrected by ``dx`` (error coordinates)."""
         raise NotImplementedError
@@ -144,10 +145,6 @@ class AugmentedEKF(KalmanCorrection, Estimator):
     def report(self, x):
         """The estimate reported in the system's coordinates, (runs, system.n)."""
         raise NotImplementedError
-
-    def report_covariance(self, P):
-        """The covariance reported with the estimate."""
-        return P
 
     def augmented(self, x):
         """The augmented states' estimate, (runs, n_aug)."""
@@ -159,24 +156,9 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
         return self.Qd, {}
 
-    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
-        """``(P(k+1|k), diagnostics, extra)``; here ``Φ P Φᵀ + Q_d`` (E1).
-
-        ``innovation`` and ``H`` are zero on the channels ``~mask`` a reading lacks (mask None: none).
-        """
-        return PhiPPhiT + Qd, {}, {}
-
-    def after_update(self, state, x_post):
-        """Extra items to keep after an update (none here)."""
-        return {}
-
-    def initial_diagnostics(self, runs):
-        """Diagnostics every step reports, at their values before any prediction."""
-        return {}
-
-    def step_diagnostics(self, state):
-        """Diagnostics that depend on the prior ``state`` (the adapted noise …)."""
-        return {}
+    def update_diagnostics(self, x_post):
+        """The augmented states' estimate after the update, ``input_estimate`` (runs, n_aug)."""
+        return {"input_estimate": self.augmented(x_post)}
 
     # -- the step contract ---------------------------------------------------------------
 
@@ -190,48 +172,6 @@ class AugmentedEKF(KalmanCorrection, Estimator):
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
-    def _update(self, state, y):
-        x = state.x
-        try:
-            yhat, H = self.observe(x)
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
-        mask = available_channels(y) if self.missing == "skip" else None
-        if mask is not None:  # a missing channel reads as predicted (innovation 0; removed below)
-            y = np.where(mask, y, yhat)
-        innovation = self.measurement.residual(y, yhat)
-        R, used = self.R, innovation
-        if mask is not None:
-            _, H, R, used = drop_missing(state.P, H, R, innovation, mask)
-        diag = self.initial_diagnostics(x.shape[0])
-        diag.update(self.step_diagnostics(state))
-        extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
-        if "PhiPPhiT" in state.extra:
-            P, d_hook, e_hook = self.complete_prior(state.extra["PhiPPhiT"], state.extra["Qd"], state, used, H,
-                                                    mask=mask)
-            diag.update(d_hook)
-            extra.update(e_hook)
-        else:
-            P = state.P
-        if mask is not None:
-            P, H, R, used = drop_missing(P, H, R, used, mask)
-        try:
-            dx, P_post, d_corr = self.correct_error(P, H, R, used)
-        except np.linalg.LinAlgError:
-            dx = P_post = np.array(np.nan)
-        if not (np.all(np.isfinite(dx)) and np.all(np.isfinite(P_post))):
-            raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
-        x_post = self.inject(x, dx)
-        extra.update(self.after_update(state, x_post))
-        runs = x.shape[0]
-        diag.update(d_corr, innovation=innovation if mask is None else np.where(mask, innovation, np.nan),
-                    input_estimate=self.augmented(x_post))
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
-        if self.output == "filtered":
-            return new, StepOutput(xhat=self.report(x_post), P=self._runs(self.report_covariance(P_post), runs),
-                                   diagnostics=diag)
-        return new, StepOutput(xhat=self.report(x), P=self._runs(self.report_covariance(P), runs), diagnostics=diag)
-
     def _predict(self, state, u):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
@@ -242,10 +182,6 @@ class AugmentedEKF(KalmanCorrection, Estimator):
         extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
         extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
         return FilterState(x=x, P=PhiPPhiT + Qd, k=state.k + 1, extra=extra)
-
-    @staticmethod
-    def _runs(P, runs):
-        return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P
 
 
 class AugmentedInputKF(AugmentedEKF):

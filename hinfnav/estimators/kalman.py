@@ -4,7 +4,9 @@
 or any dynamics model (``n``, ``n_input``, ``dt``, ``state``, ``Q``,
 ``linear`` False, ``f(x, u, t)`` and ``jacobian(x, u, t)``: the Jacobian at
 x̂(k|k) propagates P) and linearizes the measurement model at the prior estimate. It is one
-class with small hooks that the variants override:
+subclass of :class:`KalmanCore`, the one Kalman core whose single update
+(``_update``) it shares with :class:`~hinfnav.estimators.AugmentedEKF`; the
+variants override small hooks:
 
 * :meth:`~ExtendedKalmanFilter.predict_covariance` — ``Φ P Φᵀ + Q``;
 * :meth:`~ExtendedKalmanFilter.process_noise` and
@@ -38,7 +40,7 @@ from .adaptive import StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 
-__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "StrongTrackingEKF"]
+__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "StrongTrackingEKF"]
 
 #: What ``update`` reports at t_k: x̂(k|k) or x̂(k|k−1).
 OUTPUTS = ("filtered", "predicted")
@@ -47,7 +49,156 @@ OUTPUTS = ("filtered", "predicted")
 _TRANSIENT = ("prior", "PhiPPhiT", "Qd")
 
 
-class ExtendedKalmanFilter(KalmanCorrection, Estimator):
+class KalmanCore(KalmanCorrection, Estimator):
+    """The one Kalman core: hooks and the one update shared by every Kalman-type filter of the package.
+
+    :class:`ExtendedKalmanFilter` (a linear system or a dynamics model) and
+    :class:`~hinfnav.estimators.augmented.AugmentedEKF` (error coordinates
+    with augmented states, the attitude filters) are its subclasses; they
+    differ in the prediction and in the model hooks, never in the update.
+    Hooks: ``observe`` (ŷ, H at the prior), ``inject`` (x̂ corrected by δx
+    in error coordinates), ``report``/``report_covariance`` (what a step
+    returns), ``correct``/``correct_error`` (the Joseph update (J1)-(J2), or
+    Huber's), ``measurement_covariance`` (R_k), ``complete_prior`` (strong
+    tracking), ``after_update`` and the diagnostics hooks.
+    """
+
+    #: True when the covariance depends on the data (a mixin's Huber weights, fading factors …)
+    data_dependent_covariance = False
+    #: True when P(k+1|k) is completed at the next reading (:meth:`complete_prior`), e.g. by strong tracking
+    defers_prior = False
+    #: A non-finite correction or covariance is an error (HinfnavError naming the step) rather than carried on
+    refuse_nonfinite = False
+    #: Keys of ``FilterState.extra`` that live from one step to the next only
+    transient_keys = _TRANSIENT
+    #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
+    R_of_reading = None
+
+    @property
+    def n_cov(self):
+        """Dimension of the error coordinates (and of P): the state's unless set otherwise (augmented states)."""
+        return getattr(self, "_n_cov", None) or self.n_state
+
+    @n_cov.setter
+    def n_cov(self, value):
+        self._n_cov = int(value)
+
+    # -- model hooks ---------------------------------------------------------------
+
+    def observe(self, x):
+        """``(ŷ, H)`` at the prior: ŷ (runs, m), H (m, n_cov) or (runs, m, n_cov)."""
+        raise NotImplementedError
+
+    def inject(self, x, dx):
+        """The state corrected by ``dx`` (error coordinates); additive here."""
+        return x + dx
+
+    def report(self, x):
+        """The estimate reported in the system's coordinates, (runs, system.n)."""
+        return x
+
+    def report_covariance(self, P):
+        """The covariance reported with the estimate."""
+        return P
+
+    # -- idea hooks ----------------------------------------------------------------------
+
+    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+        """``(P(k+1|k), diagnostics, extra)`` at the reading y(k+1): ``F P Fᵀ + Q_d`` here.
+
+        Called only when :attr:`defers_prior` is set; ``innovation`` and ``H``
+        are zero on the channels ``~mask`` a reading lacks (mask None: none).
+        Strong tracking (:class:`~hinfnav.estimators.adaptive.StrongTracking`) overrides it.
+        """
+        return PhiPPhiT + Qd, {}, {}
+
+    def initial_diagnostics(self, runs):
+        """Diagnostics every step reports, at their values before any prediction (none here)."""
+        return {}
+
+    def step_diagnostics(self, state):
+        """Diagnostics that depend on the prior ``state`` (none here)."""
+        return {}
+
+    def update_diagnostics(self, x_post):
+        """Diagnostics that depend on the posterior estimate (none here)."""
+        return {}
+
+    def after_update(self, state, x_post):
+        """Extra items to keep after an update (none here)."""
+        return {}
+
+    def measurement_covariance(self, y, x):
+        """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
+
+        None means the constant :attr:`R` (and :meth:`correct` is called
+        without an ``R`` argument, as before this hook existed).
+        """
+        return None if self.R_of_reading is None else self.R_of_reading(y)
+
+    def correct(self, x, P, H, innovation, state, R=None):
+        """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
+
+        Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
+        (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
+        on the reading or on the missing channels (default the constant :attr:`R`).
+        """
+        dx, P_post, diag = self.correct_error(P, H, self.R if R is None else R, innovation)
+        return self.inject(x, dx), P_post, diag
+
+    # -- the step contract --------------------------------------------------------
+
+    def _update(self, state, y):
+        """The one update of the Kalman core: predicted reading, deferred prior, correction, report."""
+        x, P = state.x, state.P
+        runs = x.shape[0]
+        mask = available_channels(y) if self.missing == "skip" else None
+        try:
+            yhat, H = self.observe(x)
+            # a missing channel reads as predicted (innovation 0; removed below)
+            y, mask = fill_missing(self.measurement, y, x, yhat, mask)
+            innovation = self.measurement.residual(y, yhat)
+        except InputError as exc:
+            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
+        R_k = self.measurement_covariance(y, x)
+        diag_prior = self.initial_diagnostics(runs)
+        diag_prior.update(self.step_diagnostics(state))
+        extra = {key: val for key, val in state.extra.items() if key not in self.transient_keys}
+        if "PhiPPhiT" in state.extra:  # a deferred prior (defers_prior): completed with this reading
+            _, H_0, _, used_0 = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+            P, d_hook, e_hook = self.complete_prior(state.extra["PhiPPhiT"], state.extra["Qd"], state, used_0, H_0,
+                                                    mask=mask)
+            diag_prior.update(d_hook)
+            extra.update(e_hook)
+        try:
+            if mask is None:
+                x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
+            else:
+                if R_k is not None:  # a reading-dependent R not finite on the channels it has: the reading is not used
+                    both = mask[:, :, None] & mask[:, None, :]
+                    mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
+                P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+                x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
+        except np.linalg.LinAlgError:
+            if not self.refuse_nonfinite:
+                raise
+            x_post = P_post = np.array(np.nan)
+        if self.refuse_nonfinite and not (np.all(np.isfinite(x_post)) and np.all(np.isfinite(P_post))):
+            raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
+        extra.update(self.after_update(state, x_post))
+        diag = dict(diag_prior, **diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
+        diag.update(self.update_diagnostics(x_post))
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(extra, prior=(x, P)))
+        if self.output == "filtered":
+            return new, StepOutput(xhat=self.report(x_post), P=self._broadcast(self.report_covariance(P_post), runs),
+                                   diagnostics=diag)
+        return new, StepOutput(xhat=self.report(x), P=self._broadcast(self.report_covariance(P), runs), diagnostics=diag)
+
+    def _broadcast(self, P, runs):
+        return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P
+
+
+class ExtendedKalmanFilter(KalmanCore):
     """Extended Kalman filter of a linear system with any measurement model.
 
     Parameters
@@ -79,10 +230,6 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
 
     name = "ekf"
     symmetric_posterior = False
-    #: True when the covariance depends on the data (a mixin's Huber weights, fading factors …)
-    data_dependent_covariance = False
-    #: True when P(k+1|k) is completed at the next reading (:meth:`complete_prior`), e.g. by strong tracking
-    defers_prior = False
 
     def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
                  missing="refuse"):
@@ -119,11 +266,6 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         return (bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
                 and not self.data_dependent_covariance)
 
-    @property
-    def n_cov(self):
-        """Dimension of the error coordinates (and of P): the state's here."""
-        return self.n_state
-
     # -- hooks ------------------------------------------------------------------
 
     def predict_mean(self, x, u, t=0.0):
@@ -146,40 +288,13 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
             return F @ P @ np.swapaxes(F, -1, -2)
         return congruence(F, P)
 
+    def observe(self, x):
+        """``(h(x̂⁻), H)``: H at one prior when the covariance is shared, else per run."""
+        return self.measurement.function(x), self.measurement.jacobian(x[0] if self.shares_covariance else x)
+
     def process_noise(self, state):
         """``(Q_d, extra)``: the process noise of the step from ``state`` (constant :attr:`Q` here)."""
         return self.Q, {}
-
-    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
-        """``(P(k+1|k), diagnostics, extra)`` at the reading y(k+1): ``F P Fᵀ + Q_d`` here.
-
-        Called only when :attr:`defers_prior` is set; ``innovation`` and ``H``
-        are zero on the channels ``~mask`` a reading lacks (mask None: none).
-        Strong tracking (:class:`~hinfnav.estimators.adaptive.StrongTracking`) overrides it.
-        """
-        return PhiPPhiT + Qd, {}, {}
-
-    def initial_diagnostics(self, runs):
-        """Diagnostics every step reports, at their values before any prediction (none here)."""
-        return {}
-
-    def measurement_covariance(self, y, x):
-        """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
-
-        None means the constant :attr:`R` (and :meth:`correct` is called
-        without an ``R`` argument, as before this hook existed).
-        """
-        return None if self.R_of_reading is None else self.R_of_reading(y)
-
-    def correct(self, x, P, H, innovation, state, R=None):
-        """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
-
-        Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
-        (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
-        on the reading or on the missing channels (default the constant :attr:`R`).
-        """
-        dx, P_post, diag = self.correct_error(P, H, self.R if R is None else R, innovation)
-        return x + dx, P_post, diag
 
     # -- the step contract --------------------------------------------------------
 
@@ -189,42 +304,6 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         if not self.shares_covariance:
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
-
-    def _update(self, state, y):
-        x, P = state.x, state.P
-        mask = available_channels(y) if self.missing == "skip" else None
-        try:
-            H = self.measurement.jacobian(x[0] if self.shares_covariance else x)
-            yhat = self.measurement.function(x)
-            # a missing channel reads as predicted (innovation 0; removed below)
-            y, mask = fill_missing(self.measurement, y, x, yhat, mask)
-            innovation = self.measurement.residual(y, yhat)
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
-        R_k = self.measurement_covariance(y, x)
-        extra = state.extra
-        diag_prior = self.initial_diagnostics(x.shape[0])
-        if "PhiPPhiT" in extra:  # a deferred prior (defers_prior): completed with this reading
-            _, H_0, _, used_0 = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
-            P, d_hook, e_hook = self.complete_prior(extra["PhiPPhiT"], extra["Qd"], state, used_0, H_0, mask=mask)
-            diag_prior.update(d_hook)
-            extra = {key: val for key, val in extra.items() if key not in _TRANSIENT}
-            extra.update(e_hook)
-        if mask is None:
-            x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
-        else:
-            if R_k is not None:  # a reading-dependent R not finite on the channels it has: the reading is not used
-                both = mask[:, :, None] & mask[:, None, :]
-                mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
-            P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
-            x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
-        diag = dict(diag_prior, **diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(extra, prior=(x, P)))
-        if self.output == "filtered":
-            out = StepOutput(xhat=x_post, P=self._broadcast(P_post, x.shape[0]), diagnostics=diag)
-        else:
-            out = StepOutput(xhat=x, P=self._broadcast(P, x.shape[0]), diagnostics=diag)
-        return new, out
 
     def _predict(self, state, u):
         if self.uses_input and u is None:
@@ -248,8 +327,6 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
             P = self.predict_covariance(state.P, state)
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
-    def _broadcast(self, P, runs):
-        return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P
 
 
 class StrongTrackingEKF(StrongTracking, ExtendedKalmanFilter):
