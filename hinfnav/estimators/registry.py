@@ -13,6 +13,8 @@ call, and :func:`estimator_entry` on an unknown name, so a fresh Python process
 lists and builds every paper's estimators without this layer naming a paper.
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
 from importlib import metadata
 
@@ -40,12 +42,12 @@ PROVIDER_GROUP = "hinfnav.providers"
 _PROVIDERS = {"loaded": False}
 
 
-def providers():
+def providers() -> tuple[str, ...]:
     """The provider modules declared under :data:`PROVIDER_GROUP` by the installed packages."""
     return tuple(ep.value for ep in metadata.entry_points(group=PROVIDER_GROUP))
 
 
-def load_providers():
+def load_providers() -> dict[str, str]:
     """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
     _PROVIDERS["loaded"] = True  # first, so that a provider asking for the registry while it loads does not recurse
     failed = {}

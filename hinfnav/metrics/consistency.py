@@ -48,24 +48,21 @@ batch; it is composed into the streaming statistics of
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from numpy.typing import ArrayLike, NDArray
-
-if TYPE_CHECKING:
-    from ..sim.montecarlo import SimulationResult
-
-
-import warnings
-from dataclasses import dataclass
-
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
 from ..core.exceptions import FilterDivergenceWarning, InputError
 from ..core.validation import as_int_at_least
 from .errors import window_mask
+
+if TYPE_CHECKING:
+    from ..sim.montecarlo import SimulationResult
 
 __all__ = [
     "DIVERGENCE_FACTOR",

@@ -10,20 +10,17 @@ state's groups (``"position"``, ``"velocity"`` …, from its
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from numpy.typing import ArrayLike, NDArray
-
-if TYPE_CHECKING:
-    from ..systems.state import StateSpec
-
-
-from dataclasses import dataclass
-
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from .intervals import t_half_width
+
+if TYPE_CHECKING:
+    from ..systems.state import StateSpec
 
 __all__ = [
     "window_mask",

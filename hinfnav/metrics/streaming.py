@@ -20,25 +20,22 @@ floating-point summation (tested).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from numpy.typing import ArrayLike, NDArray
-
-if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
-    from ..estimators.base import Estimator
-    from ..noise import NoiseModel
-
-
-from dataclasses import dataclass, field
-
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..sim.montecarlo import simulate_batches
 from .consistency import NIS_KEYS, ConsistencyAccumulator, initial_scale, warn_if_diverged
 from .errors import window_mask
 from .intervals import t_half_width
+
+if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
+    from ..estimators.base import Estimator
+    from ..noise import NoiseModel
 
 __all__ = ["WindowStatistics", "MonteCarloStatistics", "monte_carlo_statistics"]
 

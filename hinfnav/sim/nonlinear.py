@@ -20,14 +20,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from numpy.typing import ArrayLike
-
-if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
-    from ..noise import NoiseModel
-
-
 import numpy as np
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
@@ -42,6 +36,10 @@ from .truth import (
     noise_models,
     scenario_truth_model,
 )
+
+if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
+    from ..noise import NoiseModel
 
 __all__ = ["run_on_truth", "simulate_nonlinear", "simulate_nonlinear_truth"]
 
