@@ -23,13 +23,23 @@ The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
 (Joseph form), which the test suite checks run by run.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter"]
 
@@ -70,8 +80,9 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
     name = "ekf"
     symmetric_posterior = False
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
-                 missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
+                 R: ArrayLike | None = None, uses_input: bool = False, output: str = "filtered", name: str | None = None,
+                 missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         n, m = system.n, measurement.n_meas
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
@@ -100,13 +111,13 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         self.Gamma = getattr(system, "Gamma", None)
 
     @property
-    def shares_covariance(self):
+    def shares_covariance(self) -> bool:
         """True when P and the gain do not depend on the data (linear measurement, constant R)."""
         return bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
 
     # -- hooks ------------------------------------------------------------------
 
-    def predict_mean(self, x, u, t=0.0):
+    def predict_mean(self, x: NDArray[np.float64], u: NDArray[np.float64] | None, t: float = 0.0) -> NDArray[np.float64]:
         """``Φ x̂ (+ Γ u)`` for a batch of estimates, or the dynamics model's ``f(x̂, u, t)`` (t the time of x̂, s)."""
         if self.nonlinear_dynamics:
             return self.system.f(x, u if self.uses_input else None, t)
@@ -115,14 +126,14 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
             out = out + u @ self.Gamma.T
         return out
 
-    def predict_covariance(self, P, state, F=None):
+    def predict_covariance(self, P: NDArray[np.float64], state: FilterState, F: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """``F P Fᵀ + Q`` with F = Φ, or the dynamics model's Jacobian at x̂(k|k) ((n, n) or (runs, n, n))."""
         F = self.F if F is None else F
         if F.ndim == 3:
             return F @ P @ np.swapaxes(F, -1, -2) + self.Q
         return congruence(F, P) + self.Q
 
-    def measurement_covariance(self, y, x):
+    def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
 
         None means the constant :attr:`R` (and :meth:`correct` is called
@@ -130,7 +141,8 @@ class ExtendedKalmanFilter(KalmanCorrection, Estimator):
         """
         return None if self.R_of_reading is None else self.R_of_reading(y)
 
-    def correct(self, x, P, H, innovation, state, R=None):
+    def correct(self, x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64], innovation: NDArray[np.float64], state: FilterState,
+                R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
 
         Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
