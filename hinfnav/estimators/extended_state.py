@@ -48,8 +48,8 @@ from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput, available_channels
 from .correction import drop_missing, kalman_gain
-from .kalman import ExtendedKalmanFilter
 from .steady import CHECK_EVERY, freeze_gain
+from .kalman import ExtendedKalmanFilter
 
 if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
