@@ -196,24 +196,11 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
     return _Check(True, "certified", gamma_c, A_F, B_F, C_F, wc, variables)
 
 
-def synthesize(
-    A: ArrayLike,
-    B: ArrayLike,
-    C: ArrayLike,
-    D: ArrayLike,
-    L: ArrayLike,
-    H: ArrayLike | None = None,
-    E: ArrayLike | None = None,
-    *,
-    dt: float | bool = True,
-    structure: str = "full",
-    uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None,
-    n_random_samples: int = 4,
-    seed: int | np.random.Generator = 0,
-    form: str = "general",
-    options: SolverOptions | None = None,
-    solver: str | None = None,
-) -> SynthesisResult:
+def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
+               E: ArrayLike | None = None, *, dt: float | bool = True, structure: str = "full",
+               uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
+               seed: int | np.random.Generator = 0, form: str = "general", options: SolverOptions | None = None,
+               solver: str | None = None) -> SynthesisResult:
     """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
 
     Parameters

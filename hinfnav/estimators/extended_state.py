@@ -31,13 +31,7 @@ converged (``steady_tol``, :func:`hinfnav.estimators.steady.freeze_gain`;
 ``None``, the default, never freezes). A clipped reading unfreezes Algorithms 2, 3.
 """
 
-from __future__ import annotations
-
-from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
-
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from ..analysis.truncated import truncated_normal_moments
 from ..core.exceptions import InputError
@@ -50,9 +44,6 @@ from .base import Estimator, FilterState, StepOutput, available_channels
 from .correction import drop_missing, kalman_gain
 from .steady import CHECK_EVERY, freeze_gain
 from .kalman import ExtendedKalmanFilter
-
-if TYPE_CHECKING:
-    from ..systems.measurements import MeasurementModel
 
 __all__ = ["ExtendedStateKalmanFilter", "SaturatedExtendedStateFilter", "FusedExtendedStateFilter",
            "theta_star", "MODES", "FUSED_COVARIANCES", "CHECK_EVERY"]
@@ -111,10 +102,8 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
 
     name = "eskf"
 
-    def __init__(self, system: LinearSystem, measurement: MeasurementModel, *, P0: ArrayLike, B_e: ArrayLike,
-                 q: ArrayLike, S: ArrayLike | None = None, R: ArrayLike | None = None, theta: float | None = None,
-                 nominal: Callable[..., Any] | None = None, steady_tol: float | None = None, name: str | None = None,
-                 missing: str = "refuse") -> None:
+    def __init__(self, system, measurement, *, P0, B_e, q, S=None, R=None, theta=None, nominal=None, steady_tol=None,
+                 name=None, missing="refuse"):
         n = system.n
         self.B_e = as_matrix("B_e", B_e, (n, None))
         self.q = as_vector("q", q, self.B_e.shape[1])
@@ -138,11 +127,11 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         self.steady_tol = _check_tol(steady_tol)
         self._q_sqrt = np.sqrt(self.q)
 
-    def predict_covariance(self, P: NDArray[np.float64], state: FilterState) -> NDArray[np.float64]:
+    def predict_covariance(self, P, state):
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` (Algorithm 1)."""
         return (1.0 + self.theta) * (self.F @ P @ self.F.T) + self.Q
 
-    def gain(self, P_prior: NDArray[np.float64], H: NDArray[np.float64] | None = None, R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def gain(self, P_prior, H=None, R=None):
         """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run).
 
         ``H``, ``R`` default to the measurement's; :func:`~hinfnav.estimators.correction.kalman_gain`.
@@ -151,8 +140,7 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
                                    symmetrize=False)
         return K, P_post
 
-    def correct(self, x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64], innovation: NDArray[np.float64], state: FilterState,
-                R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+    def correct(self, x, P, H, innovation, state, R=None):
         steady = state.extra.get("steady")
         if R is not None:  # missing channels: this step's gain, not the steady one
             K, P_post = self.gain(P, H, R)
@@ -247,11 +235,9 @@ class SaturatedExtendedStateFilter(Estimator):
     name = "saturated_eskf"
     uses_input = True
 
-    def __init__(self, A_d: ArrayLike, B_d: ArrayLike, C: ArrayLike, D: ArrayLike, *, R: ArrayLike, S: ArrayLike,
-                 q: ArrayLike, P0: ArrayLike, lower: ArrayLike, upper: ArrayLike, dt: float, mode: str = "truncated",
-                 state: StateSpec | None = None, measurement_labels: Sequence[str] | None = None,
-                 measurement_units: Sequence[str] | None = None, theta: ArrayLike | None = None,
-                 steady_tol: float | None = None, name: str | None = None, missing: str = "refuse") -> None:
+    def __init__(self, A_d, B_d, C, D, *, R, S, q, P0, lower, upper, dt, mode="truncated", state=None,
+                 measurement_labels=None, measurement_units=None, theta=None, steady_tol=None, name=None,
+                 missing="refuse"):
         A_d = np.asarray(A_d, dtype=float)
         if A_d.ndim != 3 or A_d.shape[1:] != (3, 3):
             raise InputError(f"A_d must have shape (n_axes, 3, 3); got {A_d.shape}")
@@ -310,15 +296,15 @@ class SaturatedExtendedStateFilter(Estimator):
 
     # -- array kernels (runs, n_axes, 3) -------------------------------------------------
 
-    def to_full(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
+    def to_full(self, X):
         """(runs, n_axes, 3) → (runs, 3 n_axes) in the order [r, ṙ, f]."""
         return np.swapaxes(X, 1, 2).reshape(X.shape[0], -1)
 
-    def from_full(self, x: ArrayLike) -> NDArray[np.float64]:
+    def from_full(self, x):
         """(runs, 3 n_axes) → (runs, n_axes, 3)."""
         return np.swapaxes(np.asarray(x, dtype=float).reshape(-1, 3, self.n_axes), 1, 2).copy()
 
-    def full_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
+    def full_covariance(self, P):
         """(runs, n_axes, 3, 3) → (runs, 3 n_axes, 3 n_axes) (block diagonal over axes)."""
         na = self.n_axes
         out = np.zeros((P.shape[0], 3, na, 3, na))
@@ -326,19 +312,17 @@ class SaturatedExtendedStateFilter(Estimator):
             out[:, :, a, :, a] = P[:, a]
         return out.reshape(P.shape[0], 3 * na, 3 * na)
 
-    def prior_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
+    def prior_covariance(self, P):
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` per axis."""
         return (1.0 + self.theta)[:, None, None] * (self.A @ P @ np.swapaxes(self.A, -1, -2)) + self.Qtheta
 
-    def flags(self, y: ArrayLike) -> NDArray[np.bool_]:
+    def flags(self, y):
         """Which readings sit at a bound (never in ``ideal`` mode)."""
         if self.mode == "ideal":
             return np.zeros(np.shape(y), dtype=bool)
         return (y <= self.lower) | (y >= self.upper)
 
-    def kernel_update(self, X: NDArray[np.float64], P: NDArray[np.float64], y: NDArray[np.float64], u_feed: NDArray[np.float64], cache: dict[str, Any] | None = None,
-                      sat: NDArray[np.bool_] | None = None, skip: NDArray[np.bool_] | None = None,
-                      missing: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    def kernel_update(self, X, P, y, u_feed, cache=None, sat=None, skip=None, missing=None):
         """One measurement update on arrays ``X`` (runs, n_axes, 3), ``P`` (runs, n_axes, 3, 3).
 
         ``y``, ``u_feed`` (runs, n_axes): readings and the input they contain. ``cache = (K, P_post)`` of a
@@ -391,7 +375,7 @@ class SaturatedExtendedStateFilter(Estimator):
             P_post = P_post + extra_var[..., None, None] * KKt
         return X_post, P_post, innov, sat, K
 
-    def kernel_predict(self, X: NDArray[np.float64], P: NDArray[np.float64] | None, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    def kernel_predict(self, X, P, u):
         """``X⁻ = A X + B u`` (Ĝ = 0: f̄ = 0) and the prior covariance, per axis."""
         Xp = (self.A @ X[..., None])[..., 0] + self.Bu * u[..., None]
         return Xp, (None if P is None else self.prior_covariance(P))
@@ -405,12 +389,12 @@ class SaturatedExtendedStateFilter(Estimator):
         P = np.broadcast_to(P, (runs, self.n_axes, 3, 3)).copy()
         return FilterState(x=X, P=P, extra={"u_feed": np.zeros((runs, self.n_axes)), "steady": None})
 
-    def feed_input(self, state: FilterState, u: NDArray[np.float64]) -> FilterState:
+    def feed_input(self, state, u):
         """The state with the input ``u_k`` (runs, n_axes) that the next reading contains through ``D u_k``."""
         u = self._check_feed_input(state, u)
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u), phase=state.phase)
 
-    def from_full_cov(self, P0: NDArray[np.float64]) -> NDArray[np.float64]:
+    def from_full_cov(self, P0):
         """A full (3 n_axes)² covariance → its per-axis blocks (cross-axis terms are dropped)."""
         P0 = as_covariance("P0", P0, self.n_state, definite=True)
         na = self.n_axes
@@ -475,9 +459,8 @@ class FusedExtendedStateFilter(Estimator):
     name = "fused_eskf"
     uses_input = True
 
-    def __init__(self, alg1: ExtendedStateKalmanFilter, alg2: SaturatedExtendedStateFilter, *, indices: ArrayLike,
-                 input_indices: ArrayLike, covariance: str = "symmetric", steady_tol: float | None = None,
-                 name: str | None = None, missing: str = "refuse") -> None:
+    def __init__(self, alg1, alg2, *, indices, input_indices, covariance="symmetric", steady_tol=None, name=None,
+                 missing="refuse"):
         if not isinstance(alg1, ExtendedStateKalmanFilter):
             raise InputError(f"alg1 must be an ExtendedStateKalmanFilter; got {type(alg1).__name__}")
         if not isinstance(alg2, SaturatedExtendedStateFilter):
@@ -509,7 +492,7 @@ class FusedExtendedStateFilter(Estimator):
         super().__init__(alg1.system, meas, name=name, missing=missing)
         self._m1 = m1
 
-    def fuse(self, x1: NDArray[np.float64], P1: NDArray[np.float64], X2: NDArray[np.float64], P2: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    def fuse(self, x1, P1, X2, P2):
         """(38)-(43): returns the fused ``(x1, P1, X2, P2)`` (new arrays)."""
         x1, Xo = self._fuse_mean(x1, X2)
         P1ax = P1[:, self._rr, self._cc]  # (runs, axes, 3, 3)
@@ -533,7 +516,7 @@ class FusedExtendedStateFilter(Estimator):
         P1 = np.broadcast_to(s1.P, (runs,) + s1.P.shape[-2:]).copy()
         return FilterState(x=s1.x, P=P1, extra={"X2": s2.x, "P2": s2.P, "u_feed": s2.extra["u_feed"], "steady": None})
 
-    def feed_input(self, state: FilterState, u: NDArray[np.float64]) -> FilterState:
+    def feed_input(self, state, u):
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
         u = self._check_feed_input(state, u)
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
