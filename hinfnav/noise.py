@@ -20,9 +20,13 @@ name           distribution of one sample
 =============  ==========================================================
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .core.exceptions import InputError
 from .core.validation import as_choice, as_int_at_least, as_positive, as_real
@@ -64,7 +68,7 @@ class NoiseModel:
 
     name = "noise"
 
-    def sample(self, rng, shape):
+    def sample(self, rng: np.random.Generator, shape: int | tuple[int, ...]) -> NDArray[np.float64]:
         """Draw samples.
 
         Parameters
@@ -129,7 +133,7 @@ class ColoredNoise(NoiseModel):
         as_positive("dt", self.dt)
 
     @property
-    def a(self):
+    def a(self) -> float:
         """One-step correlation ``exp(−dt/tau_s)``."""
         return float(np.exp(-self.dt / self.tau_s))
 
@@ -172,12 +176,12 @@ class MixtureNoise(NoiseModel):
         as_positive("ratio", self.ratio)
 
     @property
-    def sigma1(self):
+    def sigma1(self) -> float:
         """Standard deviation of the narrow component."""
         return 1.0 / np.sqrt((1 - self.eps) + self.eps * self.ratio**2)
 
     @property
-    def kurtosis(self):
+    def kurtosis(self) -> float:
         """Theoretical kurtosis."""
         e, r = self.eps, self.ratio
         return 3 * ((1 - e) + e * r**4) / ((1 - e) + e * r**2) ** 2
@@ -225,7 +229,7 @@ class StudentTNoise(NoiseModel):
         as_int_at_least("dof", self.dof, 5)
 
     @property
-    def kurtosis(self):
+    def kurtosis(self) -> float:
         """Theoretical kurtosis."""
         return 3.0 + 6.0 / (self.dof - 4)
 
@@ -246,7 +250,7 @@ _FACTORIES = {
 NOISE_NAMES = tuple(_FACTORIES)
 
 
-def make_noise(name, **params):
+def make_noise(name: str | NoiseModel, **params: Any) -> NoiseModel:
     """Build a noise model by name (see the module table), or pass one through.
 
     Parameters

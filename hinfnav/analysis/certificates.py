@@ -8,10 +8,15 @@ rounding-aware eigenvalue test. The discrete bounded real lemma matrix
 :mod:`hinfnav.lmi`.
 """
 
+from __future__ import annotations
+
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["certify_negative_definite", "schur_gamma", "LMICertificate", "brl_matrix", "brl_blocks"]
 
@@ -20,7 +25,7 @@ def _sym(M):
     return 0.5 * (M + M.T)
 
 
-def certify_negative_definite(M, rel_tol=1e-13):
+def certify_negative_definite(M: ArrayLike, rel_tol: float = 1e-13) -> tuple[bool, float]:
     """Rounding-aware test that a symmetric float64 matrix is negative definite.
 
     Parameters
@@ -47,7 +52,7 @@ def certify_negative_definite(M, rel_tol=1e-13):
     return bool(eig[-1] < -rel_tol * scale), float(eig[-1])
 
 
-def schur_gamma(M0, gamma_index, rel_tol=1e-13):
+def schur_gamma(M0: ArrayLike, gamma_index: ArrayLike, rel_tol: float = 1e-13) -> tuple[float, dict[str, Any]]:
     """Smallest γ for which ``M0 − γ² P_G`` is negative definite.
 
     ``P_G`` is the coordinate projection onto the rows/columns
@@ -129,7 +134,8 @@ class LMICertificate:
     status: str
 
 
-def brl_matrix(Abar, Bbar, Cbar, P, gamma2, Hbar=None, Ebar=None, lam=0.0):
+def brl_matrix(Abar: ArrayLike, Bbar: ArrayLike, Cbar: ArrayLike, P: ArrayLike, gamma2: float, Hbar: ArrayLike | None = None,
+               Ebar: ArrayLike | None = None, lam: float = 0.0) -> NDArray[np.float64]:
     """The matrix of the bounded real lemma (17), or of its robust form (26).
 
     Without ``Hbar``: Lemma 1, (17)::
@@ -168,7 +174,8 @@ def brl_matrix(Abar, Bbar, Cbar, P, gamma2, Hbar=None, Ebar=None, lam=0.0):
     )
 
 
-def brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, lib):
+def brl_blocks(Abar: NDArray[np.float64], Bbar: NDArray[np.float64], Cbar: NDArray[np.float64], Hbar: NDArray[np.float64] | None, Ebar: NDArray[np.float64] | None,
+               P: Any, lam: Any, g: Any, lib: Callable[..., Any]) -> Any:
     """LMI (17), with the uncertainty eliminated by Lemmas 2–3 when Hbar is given."""
     N = Abar.shape[0]
     nin = Bbar.shape[1]

@@ -6,20 +6,29 @@ error ``e = z − z_f`` is the output of the augmented system
 ``ξ = [x; x_f]`` driven by ``τ = [w; v]``.
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import control
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .norms import NORM_TOL, _dt_value, hinf_norm
 
+if TYPE_CHECKING:
+    from ..systems.uncertain import UncertainSystem
+
 __all__ = ["error_system_matrices", "error_system", "WorstCase", "worst_case_norm"]
 
 
-def error_system_matrices(A, B, C, D, L, A_F, B_F, C_F):
+def error_system_matrices(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, A_F: ArrayLike,
+                          B_F: ArrayLike, C_F: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """State-space matrices of the filtering error system ε_d, (13)–(14).
 
     Parameters
@@ -68,7 +77,8 @@ def error_system_matrices(A, B, C, D, L, A_F, B_F, C_F):
     return Abar, Bbar, Cbar
 
 
-def error_system(A, B, C, D, L, A_F, B_F, C_F, dt=True):
+def error_system(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, A_F: ArrayLike,
+                 B_F: ArrayLike, C_F: ArrayLike, dt: float | bool = True) -> control.StateSpace:
     """The error system ε_d of (13)–(15) as a discrete :class:`control.StateSpace`.
 
     Parameters are those of :func:`error_system_matrices`, plus
@@ -108,17 +118,19 @@ class WorstCase:
     index: int
 
     @property
-    def norm(self):
+    def norm(self) -> float:
         """Largest sampled norm (``inf`` if any sample is unstable)."""
         return float(self.norms[self.index])
 
     @property
-    def stable(self):
+    def stable(self) -> bool:
         """Whether the error system is Schur stable at every sample."""
         return bool(np.all(self.spectral_radii < 1.0))
 
 
-def worst_case_norm(system, A_F, B_F, C_F, samples=None, dt=None, tol=NORM_TOL):
+def worst_case_norm(system: UncertainSystem, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike,
+                    samples: Sequence[ArrayLike] | None = None, dt: float | bool | None = None,
+                    tol: float = NORM_TOL) -> WorstCase:
     """Worst sampled H∞ norm of the error system (13)–(15) of a filter.
 
     Parameters

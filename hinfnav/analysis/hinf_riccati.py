@@ -32,7 +32,10 @@ admissible ``theta`` form an interval ``[0, theta_max)``, on which
 :func:`max_admissible_theta` bisects with the same routine.
 """
 
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_nonnegative, as_positive
@@ -184,7 +187,8 @@ def _bisect_theta(F, Q, W, Sbar, rtol, tol, max_iter):
     return lo
 
 
-def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, max_iter=MAX_ITER):
+def max_admissible_theta(F: ArrayLike, H: ArrayLike, Q: ArrayLike, R: ArrayLike, L: ArrayLike | None = None, S: ArrayLike | None = None,
+                         rtol: float = 1e-6, *, tol: float = 1e-12, max_iter: int = MAX_ITER) -> float:
     """Largest ``theta`` for which the steady-state H-infinity filter exists.
 
     Parameters
@@ -231,7 +235,8 @@ def max_admissible_theta(F, H, Q, R, L=None, S=None, rtol=1e-6, *, tol=1e-12, ma
     return theta_max
 
 
-def steady_state_hinf(F, H, Q, R, theta, L=None, S=None, *, tol=1e-12, max_iter=MAX_ITER):
+def steady_state_hinf(F: ArrayLike, H: ArrayLike, Q: ArrayLike, R: ArrayLike, theta: float, L: ArrayLike | None = None,
+                      S: ArrayLike | None = None, *, tol: float = 1e-12, max_iter: int = MAX_ITER) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Steady-state covariance bound and gain of the a-priori H-infinity filter.
 
     Parameters

@@ -16,10 +16,16 @@ Frequencies are in rad/s when the sampling time ``dt`` is a number, in
 rad/sample when ``dt`` is ``True`` (unspecified), as in python-control.
 """
 
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
 import control
 import numpy as np
 import scipy.linalg
 import scipy.optimize
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
@@ -59,7 +65,7 @@ def _ssdata(sys):
     return (np.asarray(sys.A, float), np.asarray(sys.B, float), np.asarray(sys.C, float), np.asarray(sys.D, float))
 
 
-def frequency_response_sigma(sys, omega, all_values=False):
+def frequency_response_sigma(sys: control.StateSpace, omega: ArrayLike, all_values: bool = False) -> NDArray[np.float64]:
     """Singular values of ``G(e^{jωT})`` on a frequency grid.
 
     Parameters
@@ -87,7 +93,7 @@ def frequency_response_sigma(sys, omega, all_values=False):
     return s if all_values else s[:, 0]
 
 
-def frequency_grid(sys, points=2000, lowest=1e-7):
+def frequency_grid(sys: control.StateSpace, points: int = 2000, lowest: float = 1e-7) -> NDArray[np.float64]:
     """A frequency grid for a discrete system, dense near its pole angles.
 
     Parameters
@@ -116,7 +122,7 @@ def frequency_grid(sys, points=2000, lowest=1e-7):
     return theta / _dt_seconds(sys.dt)
 
 
-def hinf_norm(sys, tol=NORM_TOL, return_peak=False):
+def hinf_norm(sys: control.StateSpace, tol: float = NORM_TOL, return_peak: bool = False) -> float | tuple[float, float]:
     """H∞ norm of a discrete system by SLICOT ``ab13dd`` (python-control).
 
     Parameters
@@ -189,7 +195,8 @@ def _sigma_at(A, B, C, D, theta):
     return np.linalg.svd(C[None] @ X + D[None], compute_uv=False)[:, 0]
 
 
-def hinf_norm_bisection(sys, tol=1e-10, max_iter=100, unit_tol=1e-7, return_peak=False):
+def hinf_norm_bisection(sys: control.StateSpace, tol: float = 1e-10, max_iter: int = 100, unit_tol: float = 1e-7,
+                        return_peak: bool = False) -> float | tuple[float, float]:
     """H∞ norm by the Boyd–Balakrishnan / Bruinsma–Steinbuch iteration.
 
     An implementation independent of SLICOT, used to cross-check
@@ -253,7 +260,7 @@ def hinf_norm_bisection(sys, tol=1e-10, max_iter=100, unit_tol=1e-7, return_peak
     return (lower, peak / T) if return_peak else lower
 
 
-def hinf_norm_grid(sys, points=4000, refine=True):
+def hinf_norm_grid(sys: control.StateSpace, points: int = 4000, refine: bool = True) -> float:
     """Lower bound of the H∞ norm from a dense frequency grid.
 
     Parameters
@@ -291,7 +298,8 @@ def hinf_norm_grid(sys, points=4000, refine=True):
     return best
 
 
-def channel_norms(sys, inputs, outputs, tol=NORM_TOL):
+def channel_norms(sys: control.StateSpace, inputs: Mapping[str, Any], outputs: Mapping[str, Any],
+                  tol: float = NORM_TOL) -> dict[tuple[str, str], tuple[float, float]]:
     """H∞ norms (and peak frequencies) of input/output blocks of a system.
 
     Parameters
@@ -320,7 +328,7 @@ def channel_norms(sys, inputs, outputs, tol=NORM_TOL):
 
 
 
-def h2_norm(sys):
+def h2_norm(sys: control.StateSpace) -> float:
     """H2 norm of a stable discrete system: ``sqrt(trace(C W Cᵀ + D Dᵀ))``, W the controllability Gramian.
 
     Returns ``inf`` for a system that is not Schur stable.

@@ -1,6 +1,11 @@
 """Observer form of a full-order filter (12): is it ``x̂⁺ = A x̂ + G (y − C x̂)``?"""
 
+from __future__ import annotations
+
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix
@@ -8,7 +13,7 @@ from ..core.validation import as_matrix
 __all__ = ["observer_form"]
 
 
-def observer_form(A_F, B_F, C_F, A, C):
+def observer_form(A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, A: ArrayLike, C: ArrayLike) -> dict[str, Any]:
     """Express a filter with invertible ``C_F`` as an observer for ``x̂ = C_F x_f``.
 
     In the coordinates ``x̂ = C_F x_f`` the filter (12) reads

@@ -66,9 +66,14 @@ Fisher information, not its covariance). Non-additive noise needs the
 general expectations of the paper, not this additive form.
 """
 
+from __future__ import annotations
+
+from typing import Any
+
 import numpy as np
 import scipy.integrate
 import scipy.stats
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
@@ -118,8 +123,10 @@ def _add_information(P, M):
     return 0.5 * (out + out.T)
 
 
-def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P0, *,
-                  measurement_information=None, initial_update=True, diagonal_only=False, epsilon=1e-9):
+def posterior_crb(truth_states: ArrayLike, dynamics_jacobian: Any,
+                  measurement_jacobian: Any, Q: ArrayLike, R: ArrayLike, P0: ArrayLike, *,
+                  measurement_information: ArrayLike | None = None, initial_update: bool = True, diagonal_only: bool = False,
+                  epsilon: float = 1e-9) -> NDArray[np.float64]:
     """Posterior Cramér–Rao bound J(k)⁻¹ of the state along Monte Carlo truths, eqs. (T1)–(T2), (P1)–(P2).
 
     Parameters
@@ -236,7 +243,7 @@ def posterior_crb(truth_states, dynamics_jacobian, measurement_jacobian, Q, R, P
     return out
 
 
-def rms_bound(bound, start=0, stop=None):
+def rms_bound(bound: ArrayLike, start: int = 0, stop: int | None = None) -> NDArray[np.float64]:
     """RMS bound per state component over steps ``start … stop−1``: ``√(mean_k PCRB_ii(k))``.
 
     The RMS error ``√(mean_k E[e_i(k)²])`` of any estimator over the window
@@ -278,7 +285,7 @@ def _density(noise):
     return None
 
 
-def noise_fisher_information(noise):
+def noise_fisher_information(noise: NoiseModel) -> float:
     """Location Fisher information ``j = ∫ p′(e)²/p(e) de`` of a unit-variance noise model.
 
     Gaussian: 1. Laplace (scale 1/√2): 2 (closed form, the density has a kink
@@ -322,7 +329,7 @@ def noise_fisher_information(noise):
     return float(value)
 
 
-def measurement_information(D, noise):
+def measurement_information(D: ArrayLike, noise: NoiseModel) -> NDArray[np.float64]:
     """Fisher information Λ of ``v = D e``, e i.i.d. unit-variance channels of ``noise``: ``j (D Dᵀ)⁻¹``.
 
     Parameters

@@ -9,8 +9,11 @@
   Lyapunov equation on the error system (13)).
 """
 
+from __future__ import annotations
+
 import numpy as np
 import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import HinfnavError, InputError, UnstablePlantError
 from ..core.linalg import as_covariance, spectral_radius
@@ -20,7 +23,7 @@ from .error_system import error_system_matrices
 __all__ = ["steady_state_kalman", "stationary_lti_error_covariance"]
 
 
-def steady_state_kalman(A, C, Q, R):
+def steady_state_kalman(A: ArrayLike, C: ArrayLike, Q: ArrayLike, R: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Steady-state Kalman filter of ``x⁺ = A x + w``, ``y = C x + v``.
 
     Parameters
@@ -74,7 +77,9 @@ def steady_state_kalman(A, C, Q, R):
 
 
 
-def stationary_lti_error_covariance(A_t, B, C, D, A_F, B_F, C_F, *, K_truth=None, input_matrix=None, K=None):
+def stationary_lti_error_covariance(A_t: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, A_F: ArrayLike,
+                                    B_F: ArrayLike, C_F: ArrayLike, *, K_truth: ArrayLike | None = None,
+                                    input_matrix: ArrayLike | None = None, K: ArrayLike | None = None) -> NDArray[np.float64]:
     """Stationary covariance of the error of the LTI filter (12) on a stable linear truth.
 
     The truth ``x(k+1) = A_t x(k) + B w(k)``, ``y = C x + D v`` (w, v white,

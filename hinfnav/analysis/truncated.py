@@ -38,7 +38,10 @@ is at or right of the mean and then
   reduces to ``E[Y] = t``, ``Var[X] = t (s - t)``, accurate even at 1e5 sigma.
 """
 
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.special import erf, erfcx
 
 from ..core.exceptions import InputError
@@ -133,7 +136,8 @@ def _standard_moments(a, b):
     return mean, var
 
 
-def truncated_normal_moments(mean, var, lower, upper):
+def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
+                             upper: ArrayLike) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
     """Mean and variance of ``N(mean, var)`` conditioned on ``[lower, upper]``.
 
     Parameters

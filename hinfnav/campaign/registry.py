@@ -7,8 +7,13 @@ campaign grid may vary; the parameters of the scenario's
 ``truth_model(**conditions)`` are its conditions (``maneuver``, ``delta``, …).
 """
 
+from __future__ import annotations
+
 import inspect
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
+
 from ..core.exceptions import InputError
 from ..estimators.registry import PROVIDER_GROUP, load_providers, providers
 
@@ -26,7 +31,7 @@ class _ScenarioEntry:
 _SCENARIOS = {}
 
 
-def register_scenario(name, factory, *, description=""):
+def register_scenario(name: str, factory: Callable[..., Any], *, description: str = "") -> None:
     """Register ``factory(**settings) -> scenario`` under ``name``.
 
     Parameters
@@ -46,12 +51,12 @@ def register_scenario(name, factory, *, description=""):
     _SCENARIOS[name] = _ScenarioEntry(name, factory, description)
 
 
-def registered_scenarios():
+def registered_scenarios() -> tuple[str, ...]:
     """Names of the registered scenarios, in registration order."""
     return tuple(_SCENARIOS)
 
 
-def scenario_entry(name, field="scenario"):
+def scenario_entry(name: str, field: str = "scenario") -> _ScenarioEntry:
     """The registry entry of ``name``; an :class:`InputError` naming ``field`` and the known names otherwise."""
     if name not in _SCENARIOS:
         load_providers()
@@ -71,16 +76,16 @@ def _keyword_names(func):
     return tuple(p.name for p in params if p.kind in kinds and p.name != "self")
 
 
-def scenario_parameters(name):
+def scenario_parameters(name: str) -> tuple[str, ...]:
     """Settings the scenario ``name`` accepts (the keyword parameters of its factory)."""
     return _keyword_names(scenario_entry(name).factory)
 
 
-def condition_parameters(scenario):
+def condition_parameters(scenario: Any) -> tuple[str, ...]:
     """Conditions a scenario's ``truth_model`` accepts (``maneuver``, ``delta``, ``discretization`` for Sun 2011)."""
     return _keyword_names(scenario.truth_model)
 
 
-def build_scenario(name, **settings):
+def build_scenario(name: str, **settings: Any) -> Any:
     """The scenario registered as ``name`` with ``settings`` (validated by the scenario itself)."""
     return scenario_entry(name).factory(**settings)

@@ -30,13 +30,17 @@ draws from its own child generator, and the batches are those of the spec's
 ``batch_size`` (tested bitwise against a serial run).
 """
 
+from __future__ import annotations
+
 import contextlib
 import importlib
 import json
 import logging
 import os
 import time
+from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from tqdm import tqdm
@@ -54,6 +58,11 @@ from .spec import canonical, load_campaign
 from .stats import CellAccumulator
 from .table import results_table
 
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from .spec import Campaign
+
 __all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "SERIAL"]
 
 #: ``client=SERIAL`` runs every task in this process, one after another (no cluster; for debugging and tests).
@@ -65,7 +74,7 @@ _BUILT = {}  # per process: (scenario, settings, estimator, options) -> Estimato
 _MAX_BUILT = 64
 
 
-def clear_cache():
+def clear_cache() -> None:
     """Forget the estimators this process has built (designs are solved again on next use)."""
     _BUILT.clear()
 
@@ -90,7 +99,7 @@ def _estimator(scenario, name, settings, est, options):
     return _BUILT[key]
 
 
-def campaign_units(campaign, pending=None):
+def campaign_units(campaign: Campaign, pending: Collection[str] | None = None) -> list[dict[str, Any]]:
     """The tasks of a campaign: dicts holding one truth and the cells (estimators) to run on it.
 
     Parameters
@@ -119,7 +128,7 @@ def campaign_units(campaign, pending=None):
     return out
 
 
-def run_unit(unit):
+def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Run one task (see :func:`campaign_units`); return one result dict per cell.
 
     Executed on a worker: imports the modules that register the scenario and
@@ -265,7 +274,8 @@ def _open_client(client, workers, connect_timeout):
 
 
 @contextlib.contextmanager
-def campaign_client(client=None, *, workers=None, connect_timeout=5.0):
+def campaign_client(client: Any = None, *, workers: int | None = None,
+                    connect_timeout: float = 5.0) -> Iterator[Any]:
     """Context manager: the Dask client for several campaigns (a LocalCluster started once, closed at the end).
 
     ``client`` as in :func:`run_campaign`; ``"serial"`` is passed through. Yields what to pass as ``client``.
@@ -337,7 +347,9 @@ def _check_estimators(campaign):
                 raise InputError(f"{field}: cannot build {est!r} for {where}: {exc}") from None
 
 
-def run_campaign(spec, client=None, out_dir=None, progress=True, *, workers=None, connect_timeout=5.0, limits=None):
+def run_campaign(spec: Campaign | Mapping[str, Any] | str | os.PathLike[str], client: Any = None,
+                 out_dir: str | os.PathLike[str] | None = None, progress: bool = True, *, workers: int | None = None,
+                 connect_timeout: float = 5.0, limits: Mapping[str, float] | None = None) -> pd.DataFrame:
     """Run a campaign on Dask and return its tidy results table.
 
     With the default LocalCluster, a script must call it under ``if __name__ == "__main__":`` (Dask starts its
@@ -472,7 +484,7 @@ def _run_distributed(units, client, workers, connect_timeout, collect):
             _close(dask_client)
 
 
-def read_campaign(out_dir):
+def read_campaign(out_dir: str | os.PathLike[str]) -> pd.DataFrame:
     """The tidy table of the cells a campaign folder holds (finished cells only), without running anything.
 
     Returns

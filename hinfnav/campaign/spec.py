@@ -48,14 +48,19 @@ runner also builds each estimator once per tried settings
 filter made for another sampling time are refused before any cell runs.
 """
 
+from __future__ import annotations
+
 import hashlib
 import itertools
 import json
 import math
 import numbers
+import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..core.exceptions import InputError
 from ..estimators.registry import estimator_entry, registered_estimators
@@ -86,7 +91,7 @@ STEPS_PER_SECOND = 6e5
 FULL_CHECK = 32
 
 
-def canonical(value):
+def canonical(value: Any) -> Any:
     """A JSON-ready canonical form for hashing: numbers as floats (so 1 and 1.0 are one value), lists for tuples."""
     if isinstance(value, bool) or value is None or isinstance(value, str):
         return value
@@ -101,7 +106,7 @@ def canonical(value):
     raise InputError(f"campaign values must be numbers, booleans, strings or lists of them; got {type(value).__name__}")
 
 
-def digest(obj):
+def digest(obj: Any) -> str:
     """SHA-256 hex digest of the canonical JSON of ``obj``."""
     text = json.dumps(canonical(obj), sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode()).hexdigest()
@@ -141,7 +146,7 @@ class Cell:
     cell_id: str
 
     @property
-    def params(self):
+    def params(self) -> dict[str, Any]:
         """The cell's parameters as one flat dict (scenario, estimator, noise, settings, conditions)."""
         return {"scenario": self.scenario, "estimator": self.estimator, "noise": self.noise, **self.settings,
                 **self.conditions}
@@ -260,7 +265,7 @@ class Campaign:
     # -- construction --------------------------------------------------------
 
     @classmethod
-    def from_dict(cls, data, *, source="campaign"):
+    def from_dict(cls, data: Mapping[str, Any], *, source: str = "campaign") -> Campaign:
         """A campaign from a dict with the fields of :data:`FIELDS` (a TOML file's content)."""
         if not isinstance(data, dict):
             raise InputError(f"{source} must be a table of fields; got {type(data).__name__}")
@@ -272,7 +277,7 @@ class Campaign:
                 raise InputError(f"{source}: field {key!r} is missing")
         return cls(**data)
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         """The spec as a JSON-ready dict (what :meth:`from_dict` reads)."""
         return {"name": self.name, "runs": self.runs, "seed": self.seed, "batch_size": self.batch_size,
                 "grid": {k: list(v) for k, v in self.grid.items()},
@@ -357,7 +362,7 @@ class Campaign:
             raise InputError(f"grid: {n_cells} cells ({sizes or '1 point'} × {n_est} estimators) exceed the limit "
                              f"of {limits['cells']:g} cells (raise it with limits={{'cells': N}} or --limit cells=N)")
 
-    def estimate(self):
+    def estimate(self) -> dict[str, float]:
         """Estimated work and memory of the campaign (after validation): a dict.
 
         ``steps``: estimator steps, cells × runs × the longest validated scenario's time steps; ``seconds``:
@@ -371,7 +376,7 @@ class Campaign:
         return {"steps": total, "seconds": total / STEPS_PER_SECOND,
                 "batch_bytes": float(min(self.batch_size, self.runs)) * (steps + 1) * per_step * 8}
 
-    def cells(self, limits=None):
+    def cells(self, limits: Mapping[str, float] | None = None) -> list[Cell]:
         """Every cell of the grid, in grid order, after the checks of the module docstring (limits, names, values).
 
         Parameters
@@ -426,7 +431,7 @@ class Campaign:
                                  f"(raise it with limits={{'{key}': N}} or --limit {key}=N if you mean it)")
         return self._cells
 
-    def tried(self):
+    def tried(self) -> tuple[tuple[Any, ...], ...]:
         """``(scenario name, settings, scenario, estimator names)`` of each settings combination validated."""
         self.cells()
         return self._tried
@@ -461,7 +466,7 @@ def _variants(grid, keys):
     return [base] + [{**base, k: v} for k in keys for v in grid[k][1:]]
 
 
-def load_campaign(spec):
+def load_campaign(spec: Campaign | Mapping[str, Any] | str | os.PathLike[str]) -> Campaign:
     """A :class:`Campaign` from a Campaign, a dict, or the path of a TOML file."""
     if isinstance(spec, Campaign):
         return spec

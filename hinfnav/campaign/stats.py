@@ -17,12 +17,21 @@ and NIS per step with their 95 % χ² bounds, per window their mean and the
 fraction of steps inside, and the ``diverged`` flag with its reasons.
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..metrics.consistency import ConsistencyAccumulator
 from ..metrics.errors import window_mask
 from ..metrics.intervals import t_half_width
 from ..metrics.streaming import WindowStatistics
+
+if TYPE_CHECKING:
+    from ..systems.state import StateSpec
 
 __all__ = ["CellAccumulator", "group_summary", "rms_interval"]
 
@@ -49,7 +58,7 @@ class CellAccumulator:
         Per-component tolerance of the convergence time.
     """
 
-    def __init__(self, windows, runs, tol=None):
+    def __init__(self, windows: Mapping[str, Sequence[float]], runs: int, tol: Sequence[float] | None = None) -> None:
         self.windows = dict(windows)
         self.runs = int(runs)
         self.tol = tol
@@ -58,7 +67,8 @@ class CellAccumulator:
         self._conv = []
         self.consistency = ConsistencyAccumulator(self.runs)
 
-    def add(self, start, t, err, state, P=None, innovation=None, S=None, scale0=None):
+    def add(self, start: int, t: NDArray[np.float64], err: NDArray[np.float64], state: StateSpec | None, P: NDArray[np.float64] | None = None,
+            innovation: NDArray[np.float64] | None = None, S: NDArray[np.float64] | None = None, scale0: NDArray[np.float64] | None = None) -> None:
         """Add the errors ``err`` (shape (batch, samples, n)) of runs ``start … start + batch − 1``.
 
         ``P``, ``innovation``, ``S`` and ``scale0``: the covariance history,
@@ -95,17 +105,17 @@ class CellAccumulator:
         self.consistency.add(t, err, P, innovation, S, scale0)
 
     @property
-    def nonfinite(self):
+    def nonfinite(self) -> int:
         """Number of runs added whose errors are not all finite."""
         return self.consistency.nonfinite_runs
 
-    def window_statistics(self):
+    def window_statistics(self) -> dict[str, WindowStatistics]:
         """Name → :class:`~hinfnav.metrics.WindowStatistics` (the same object the streaming Monte Carlo returns)."""
         return {name: WindowStatistics(tuple(self.windows[name]), np.sqrt(self._sums[name] / self._counts[name]),
                                        self._per_run[name], self._max[name])
                 for name in self.windows}
 
-    def result(self, filter_name="filter"):
+    def result(self, filter_name: str = "filter") -> dict[str, Any]:
         """JSON-ready statistics: per window and component, per window and state group, convergence, consistency."""
         st = self.state
         labels = list(st.labels) if st is not None else [f"x{i}" for i in range(self._sums[next(iter(self.windows))].size)]
@@ -134,7 +144,7 @@ class CellAccumulator:
                 "consistency": self.consistency.result(filter_name).summary(self.windows)}
 
 
-def rms_interval(ms):
+def rms_interval(ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """95 % interval of the pooled RMS from the per-run mean squares ``ms`` (shape (runs,) or (runs, n)).
 
     Every run has the same number of samples in a window, so the pooled mean
@@ -151,7 +161,7 @@ def rms_interval(ms):
     return np.sqrt(np.maximum(m - half, 0.0)), np.sqrt(m + half)
 
 
-def group_summary(ws, idx):
+def group_summary(ws: WindowStatistics, idx: Iterable[int]) -> dict[str, float]:
     """RMS over the components ``idx`` of a :class:`WindowStatistics`: pooled with its interval, per-run mean,
     95 % CI, spread, max."""
     idx = list(idx)

@@ -21,6 +21,11 @@ Consistency per window (quantity ``nees`` or ``nis``, kind
 components' RMS (Table 1 of Sun 2011 reports position and velocity so).
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
 import pandas as pd
 
 __all__ = ["results_table", "STATISTICS", "COLUMNS"]
@@ -72,7 +77,7 @@ def _rows(cell):
                 yield dict(wb, quantity=key, statistic=stat, value=_num(value))
 
 
-def results_table(cells):
+def results_table(cells: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     """The tidy :class:`pandas.DataFrame` of a list of cell results (see the module docstring)."""
     params = []
     for cell in cells:

@@ -26,7 +26,10 @@ Everything acts on batches (rows are runs); the integrators are carried in
 an explicit controller state.
 """
 
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_matrix, as_nonnegative, as_positive
@@ -37,7 +40,7 @@ __all__ = ["fal", "NonlinearPID", "DragFreeADRC", "INTEGRALS", "saturate"]
 INTEGRALS = ("printed", "dt", "off")
 
 
-def fal(e, alpha=0.5, delta=0.01):
+def fal(e: ArrayLike, alpha: float = 0.5, delta: float = 0.01) -> NDArray[np.float64]:
     """Han's ``fal(e, α, δ)``: linear with slope ``δ^{α−1}`` inside ``|e| ≤ δ``, ``|e|^α sign(e)`` outside.
 
     Parameters
@@ -69,7 +72,7 @@ def _fal(e, alpha, delta):
     return np.where(inside, lin, np.sign(e) * np.maximum(ae, delta) ** alpha)
 
 
-def saturate(u, bound):
+def saturate(u: ArrayLike, bound: float) -> NDArray[np.float64]:
     """Clip every component to ``[−bound, bound]`` (the cube B(ρ) of Remark 5)."""
     return np.clip(u, -bound, bound)
 
@@ -92,7 +95,8 @@ class NonlinearPID:
         Use ``g(e) = e`` (a linear PID) instead of fal.
     """
 
-    def __init__(self, kp, ki, kd, *, alpha=0.5, delta=0.01, integral="printed", dt=0.1, linear=False):
+    def __init__(self, kp: ArrayLike, ki: ArrayLike, kd: ArrayLike, *, alpha: float = 0.5, delta: float = 0.01,
+                 integral: str = "printed", dt: float = 0.1, linear: bool = False) -> None:
         self.kp, self.ki, self.kd = (np.asarray(v, dtype=float) for v in (kp, ki, kd))
         for name, v in (("kp", self.kp), ("ki", self.ki), ("kd", self.kd)):
             if not np.all(np.isfinite(v)) or np.any(v < 0):
@@ -105,7 +109,7 @@ class NonlinearPID:
         self.linear = bool(linear)
         self._iscale = {"printed": 1.0, "dt": self.dt, "off": 0.0}[self.integral]
 
-    def g(self, e):
+    def g(self, e: NDArray[np.float64]) -> NDArray[np.float64]:
         """fal(e, α, δ), or e for a linear PID."""
         return e if self.linear else _fal(e, self.alpha, self.delta)
 
@@ -142,8 +146,10 @@ class DragFreeADRC:
     n_state = 27
     n_input = 9
 
-    def __init__(self, *, I_sc, I_tm, m_sc, m_tm, K_trans, D_trans, K_rot, D_rot, attitude, dragfree, relative, bound,
-                 dragfree_compensation=True):
+    def __init__(self, *, I_sc: ArrayLike, I_tm: ArrayLike, m_sc: float, m_tm: float, K_trans: ArrayLike,
+                 D_trans: ArrayLike, K_rot: ArrayLike, D_rot: ArrayLike, attitude: NonlinearPID,
+                 dragfree: NonlinearPID, relative: NonlinearPID, bound: float,
+                 dragfree_compensation: bool = True) -> None:
         self.I_sc = as_matrix("I_sc", I_sc, (3, 3))
         self.I_tm = as_matrix("I_tm", I_tm, (3, 3))
         self.m_sc = as_positive("m_sc", m_sc)
@@ -176,7 +182,7 @@ class DragFreeADRC:
         self._pos = np.r_[0:3, 9:12, 18:21]
         self._rate = np.r_[3:6, 12:15, 21:24]
 
-    def start(self, runs):
+    def start(self, runs: int) -> NDArray[np.float64]:
         """Zero integrators e_i of the nine channels (attitude, drag-free, relative attitude): shape (runs, 9)."""
         return np.zeros((int(runs), 9))
 

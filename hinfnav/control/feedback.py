@@ -1,6 +1,9 @@
 """Feedback laws that act on the true or on the estimated state."""
 
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_matrix
@@ -24,18 +27,18 @@ class LinearFeedback:
     name : str
     """
 
-    def __init__(self, K, *, source="truth", name="linear feedback"):
+    def __init__(self, K: ArrayLike, *, source: str = "truth", name: str = "linear feedback") -> None:
         self.K = as_matrix("K", K)
         self.K.setflags(write=False)
         self.source = as_choice("feedback source", source, SOURCES)
         self.name = str(name)
 
     @property
-    def n_input(self):
+    def n_input(self) -> int:
         return self.K.shape[0]
 
     @property
-    def n_state(self):
+    def n_state(self) -> int:
         return self.K.shape[1]
 
     def __call__(self, x):
@@ -45,7 +48,7 @@ class LinearFeedback:
             raise InputError(f"the feedback law needs states with {self.n_state} components; got shape {x.shape}")
         return x @ self.K.T
 
-    def acting_on(self, source):
+    def acting_on(self, source: str) -> LinearFeedback:
         """The same gain acting on ``source`` ("truth" or "estimate")."""
         return LinearFeedback(self.K, source=source, name=self.name)
 

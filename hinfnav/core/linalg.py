@@ -6,8 +6,11 @@ inverse of a batch of small symmetric positive definite matrices (the
 innovation covariances of filters run with a leading runs dimension).
 """
 
+from __future__ import annotations
+
 import numpy as np
 import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
 
 from .exceptions import InputError
 from .validation import as_choice, as_matrix, as_positive
@@ -60,7 +63,8 @@ def as_covariance(name, value, n, definite):
     return M
 
 
-def discretize(Ac, Gc, dt, method="exact"):
+def discretize(Ac: ArrayLike, Gc: ArrayLike, dt: float,
+               method: str = "exact") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Discretize ``ẋ = Ac x + Gc u`` with a zero-order hold on ``u``.
 
     Parameters

@@ -8,6 +8,10 @@ time) — and reports each certified γ with the worst H∞ norm sampled on a
 dense grid of the simplex, or why the design does not exist.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ..core.exceptions import HinfnavError, InputError
@@ -16,10 +20,15 @@ from .explain import small_gain_number
 from .polytopic import sampled_norms, synthesize_polytopic
 from .robust_hinf import synthesize
 
+if TYPE_CHECKING:
+    from ..systems.uncertain import UncertainSystem
+
 __all__ = ["compare_uncertainty_models"]
 
 
-def compare_uncertainty_models(system, *, form="general", norm_bounded=True, grid_points=None, solver=None):
+def compare_uncertainty_models(system: PolytopicSystem, *, form: str = "general",
+                               norm_bounded: bool | UncertainSystem = True, grid_points: int | None = None,
+                               solver: str | None = None) -> list[dict[str, Any]]:
     """One row per uncertainty model: ``model``, ``covers``, ``gamma``, ``worst_sampled``, ``status``.
 
     Parameters

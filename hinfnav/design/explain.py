@@ -9,8 +9,11 @@ lemma), whatever the filter. :func:`infeasibility_hint` turns it into advice;
 cannot be handled in the general form.
 """
 
+from __future__ import annotations
+
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.norms import hinf_norm
 from ..core.linalg import spectral_radius
@@ -18,7 +21,7 @@ from ..core.linalg import spectral_radius
 __all__ = ["small_gain_number", "infeasibility_hint", "unstable_plant_message"]
 
 
-def small_gain_number(A, H, E):
+def small_gain_number(A: ArrayLike, H: ArrayLike | None, E: ArrayLike | None) -> float:
     """``‖E(zI − A)⁻¹H‖∞`` (dimensionless; ``inf`` if A is not Schur stable, ``0`` without H, E)."""
     if H is None or E is None or not (np.any(H) and np.any(E)):
         return 0.0

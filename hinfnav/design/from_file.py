@@ -8,6 +8,11 @@ written as the polytope of its sign vertices
 polytopes go to :func:`~hinfnav.design.synthesize_polytopic`.
 """
 
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ..core.provenance import provenance
@@ -17,10 +22,13 @@ from ..systems.polytopic import PolytopicSystem
 from .polytopic import COVERS, LYAPUNOV, PolytopicResult, synthesize_polytopic
 from .robust_hinf import synthesize
 
+if TYPE_CHECKING:
+    from .result import SynthesisResult
+
 __all__ = ["design_from_system_file", "design_summary"]
 
 
-def design_summary(result):
+def design_summary(result: SynthesisResult | PolytopicResult) -> dict[str, Any]:
     """JSON-ready summary of a certified design (either result type)."""
     poly = isinstance(result, PolytopicResult)
     system = result.system
@@ -47,7 +55,9 @@ def design_summary(result):
     }
 
 
-def design_from_system_file(path, *, lyapunov=None, form="general", objective="hinf", solver=None):
+def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | None = None, form: str = "general",
+                            objective: str = "hinf", solver: str | None = None
+                            ) -> tuple[SynthesisResult | PolytopicResult, dict[str, Any]]:
     """Read ``path`` (:func:`~hinfnav.systems.read_system_file`) and design a certified H∞ filter.
 
     Parameters

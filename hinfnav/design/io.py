@@ -13,8 +13,14 @@ B …), so a filter is never run on a system it was not designed and certified
 for.
 """
 
+from __future__ import annotations
+
 import hashlib
 import json
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -41,7 +47,7 @@ def _system_dict(system, dt):
     return out
 
 
-def system_fingerprint(system, dt):
+def system_fingerprint(system: UncertainSystem | PolytopicSystem, dt: float) -> str:
     """SHA-256 of the system's matrices (rounded to 12 significant digits) and its sampling time."""
     h = hashlib.sha256()
     for k in _MATRICES:
@@ -199,7 +205,9 @@ def check_design_path(path):
     return check_new_file("path", path, example="design.json")
 
 
-def save_design(result, system, path, *, options=None, extra=None):
+def save_design(result: SynthesisResult | PolytopicResult, system: UncertainSystem | PolytopicSystem,
+                path: str | os.PathLike[str], *, options: Mapping[str, Any] | None = None,
+                extra: Mapping[str, Any] | None = None) -> Path:
     """Write a design file (JSON); returns the path. The file is written whole or not at all."""
     path = check_design_path(path)
     text = json.dumps(design_to_dict(result, system, options=options, extra=extra), indent=2) + "\n"
@@ -209,7 +217,8 @@ def save_design(result, system, path, *, options=None, extra=None):
     return path
 
 
-def load_design(path):
+def load_design(path: str | os.PathLike[str]) -> tuple[SynthesisResult | PolytopicResult, UncertainSystem | PolytopicSystem,
+                                                     dict[str, Any]]:
     """Read a design file; returns ``(SynthesisResult, UncertainSystem, dict)``."""
     path = as_path("path", path)
     if not path.is_file():
@@ -221,7 +230,8 @@ def load_design(path):
     return design_from_dict(d, path)
 
 
-def check_design_system(stored, stored_dt, system, dt, *, what="the scenario"):
+def check_design_system(stored: UncertainSystem | PolytopicSystem, stored_dt: float,
+                        system: UncertainSystem | PolytopicSystem, dt: float, *, what: str = "the scenario") -> None:
     """Raise :class:`InputError` naming what differs when a design's system is not ``system`` at ``dt``."""
     if abs(float(stored_dt) - float(dt)) > 1e-12 * max(1.0, abs(float(dt))):
         raise InputError(f"the design was made for sampling time T = {float(stored_dt):g} s but {what} has "

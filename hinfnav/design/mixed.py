@@ -40,12 +40,17 @@ filter rebuilt by ``A_F = Z⁻¹Ā_F``, ``B_F = Z⁻¹B̄_F``, ``C_F = C̄_F``:
    Lyapunov equation) ≤ ``h2_bound``.
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..analysis.certificates import schur_gamma
 from ..analysis.error_system import error_system, error_system_matrices, worst_case_norm
@@ -113,7 +118,7 @@ class MixedSynthesisResult(SynthesisResult):
     gamma_bound: float = None
     lyapunov: str = "extended"
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         """JSON-ready numbers of the design (no matrices)."""
         return {
             "gamma_bound": self.gamma_bound,
@@ -156,31 +161,31 @@ class MixedFront:
     total_time_s: float = float("nan")
 
     @property
-    def gamma_bounds(self):
+    def gamma_bounds(self) -> NDArray[np.float64]:
         """Requested γ per point, shape (k,)."""
         return np.array([r.gamma_bound for r in self.results])
 
     @property
-    def gammas(self):
+    def gammas(self) -> NDArray[np.float64]:
         """Certified γ per point, shape (k,)."""
         return np.array([r.gamma for r in self.results])
 
     @property
-    def nus(self):
+    def nus(self) -> NDArray[np.float64]:
         """Certified ν per point, shape (k,)."""
         return np.array([r.h2_bound for r in self.results])
 
     @property
-    def synthesis_nus(self):
+    def synthesis_nus(self) -> NDArray[np.float64]:
         """ν certified at the synthesis LMI's own variables, per point, shape (k,)."""
         return np.array([r.h2_synthesis_bound for r in self.results])
 
-    def monotone(self, rtol=1e-6):
+    def monotone(self, rtol: float = 1e-6) -> bool:
         """Whether each point's certified ν is non-increasing along the grid (γ ascending), to ``rtol``."""
         nus = self.nus
         return bool(np.all(nus[1:] <= nus[:-1] * (1.0 + rtol)))
 
-    def pareto(self):
+    def pareto(self) -> tuple[NDArray[np.float64], list[MixedSynthesisResult]]:
         """The Pareto front of the certified designs: at each γ of the grid, the best design certified at ≤ γ.
 
         Every design (the points and the unconstrained H2 design) is a
@@ -202,11 +207,11 @@ class MixedFront:
         return np.array(nus), designs
 
     @property
-    def knee(self):
+    def knee(self) -> int:
         """Index of the knee of the Pareto front (:func:`knee_index` on :meth:`pareto`)."""
         return knee_index(self.gamma_bounds, self.pareto()[0])
 
-    def table(self):
+    def table(self) -> list[dict[str, Any]]:
         """One dict per point (:meth:`MixedSynthesisResult.as_dict`), the H2 point last."""
         rows = [r.as_dict() for r in self.results]
         if self.h2_result is not None:
@@ -214,7 +219,7 @@ class MixedFront:
         return rows
 
 
-def front_gammas(gamma_star, points=12, span=10.0, first=1e-3):
+def front_gammas(gamma_star: float, points: int = 12, span: float = 10.0, first: float = 1e-3) -> NDArray[np.float64]:
     """γ grid of a front: ``γ* (1 + s)``, s log-spaced from ``first`` to ``span − 1``.
 
     Dense near γ* where ν changes fastest; the last point is ``span · γ*``.
@@ -234,7 +239,7 @@ def front_gammas(gamma_star, points=12, span=10.0, first=1e-3):
     return gamma_star * (1.0 + np.logspace(math.log10(first), math.log10(span - 1.0), points))
 
 
-def knee_index(gammas, nus):
+def knee_index(gammas: ArrayLike, nus: ArrayLike) -> int:
     """Knee of a trade-off curve ν(γ) by the largest distance to its chord (Kneedle).
 
     In normalized coordinates ``x = (log γ − log γ₀)/(log γ_k − log γ₀)`` and
@@ -479,9 +484,11 @@ _DOC_PARAMS = """
 """
 
 
-def synthesize_mixed(A, B, C, D, L, H=None, E=None, *, gamma=None, dt=True, structure="full",
-                     uncertainty_samples=None, n_random_samples=4, seed=0, lyapunov="extended", options=None,
-                     solver=None):
+def synthesize_mixed(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
+                     E: ArrayLike | None = None, *, gamma: float | None = None, dt: float | bool = True, structure: str = "full",
+                     uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
+                     seed: int | np.random.Generator = 0, lyapunov: str = "extended", options: SolverOptions | None = None,
+                     solver: str | None = None) -> MixedSynthesisResult:
     """Robust mixed H2/H∞ filter: minimize the certified worst-case H2 norm ν subject to the H∞ bound γ.
 
     Parameters
@@ -519,9 +526,13 @@ def synthesize_mixed(A, B, C, D, L, H=None, E=None, *, gamma=None, dt=True, stru
     return dataclasses.replace(res, total_time_s=time.perf_counter() - designer.t_start)
 
 
-def mixed_front(A, B, C, D, L, H=None, E=None, *, gammas, include_h2=True, dt=True, structure="full",
-                uncertainty_samples=None, n_random_samples=4, seed=0, lyapunov="extended", options=None,
-                solver=None, gamma_star=None, hinf_result=None, progress=None):
+def mixed_front(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
+                E: ArrayLike | None = None, *, gammas: Sequence[float], include_h2: bool = True, dt: float | bool = True,
+                structure: str = "full", uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None,
+                n_random_samples: int = 4, seed: int | np.random.Generator = 0, lyapunov: str = "extended",
+                options: SolverOptions | None = None, solver: str | None = None, gamma_star: float | None = None,
+                hinf_result: SynthesisResult | None = None,
+                progress: Callable[[MixedSynthesisResult], object] | None = None) -> MixedFront:
     """Certified mixed designs along a γ grid (one compiled problem, re-solved per γ).
 
     Parameters

@@ -22,11 +22,16 @@ Lyapunov matrix, every arbitrarily time-varying α(k) in the simplex
 time (a Lyapunov function ``ξᵀ(Σ αᵢ Pᵢ)ξ`` for each α).
 """
 
+from __future__ import annotations
+
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.certificates import certify_negative_definite, schur_gamma
 from ..analysis.error_system import worst_case_norm
@@ -113,7 +118,7 @@ class PolytopicResult:
     system: object = None
     objective: str = "hinf"
 
-    def statespace(self):
+    def statespace(self) -> control.StateSpace:
         """The filter as a discrete :class:`control.StateSpace` (y → z_f)."""
         return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
 
@@ -140,7 +145,8 @@ def error_coordinates(vertex, A_F, B_F, C_F, form):
     return Abar, Bbar, np.hstack([L, -C_F])
 
 
-def certify_polytopic(system, A_F, B_F, C_F, witness, form="general"):
+def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike,
+                      witness: Mapping[str, Any], form: str = "general") -> tuple[float, list[float]]:
     """Smallest γ for which (E1) holds in float64 at every vertex with the witness ``P``, ``G`` (no solver).
 
     Returns
@@ -234,8 +240,9 @@ def _check(system, form):
             raise UnstablePlantError(unstable_plant_message(rho, f"vertex {i} ({system.labels[i]})"))
 
 
-def synthesize_polytopic(system, *, lyapunov="parameter-dependent", form="general", solver=None, grid_points=None,
-                         seed=0, objective="hinf"):
+def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-dependent", form: str = "general",
+                         solver: str | None = None, grid_points: int | None = None, seed: int | np.random.Generator = 0,
+                         objective: str = "hinf") -> PolytopicResult:
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters

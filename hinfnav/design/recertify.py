@@ -10,6 +10,11 @@ recomputed is at most the stored γ (relative 1e-6) and no sampled norm
 exceeds it.
 """
 
+from __future__ import annotations
+
+import os
+from typing import Any
+
 import numpy as np
 
 from ..analysis.certificates import brl_matrix, schur_gamma
@@ -55,7 +60,7 @@ def _lmi_levels(result, system):
     return out
 
 
-def recertify(path):
+def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Re-check a saved design in float64 without a solver and report.
 
     Parameters

@@ -1,11 +1,18 @@
 """The result of a certified robust filter synthesis."""
 
+from __future__ import annotations
+
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.error_system import error_system
+
+if TYPE_CHECKING:
+    from ..systems.uncertain import UncertainSystem
 
 __all__ = ["SynthesisResult"]
 
@@ -101,16 +108,16 @@ class SynthesisResult:
     sample_labels: tuple = ()
     system: object = None
 
-    def statespace(self):
+    def statespace(self) -> control.StateSpace:
         """The filter as a discrete :class:`control.StateSpace` (y → z_f), with ``dt``."""
         return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
 
     @property
-    def worst_delta(self):
+    def worst_delta(self) -> float | None:
         """Parameter value (δ) of the worst sample (None when the samples carry no values)."""
         return None if self.deltas is None else float(self.deltas[self.worst_sample])
 
-    def error_system(self, system, F=None):
+    def error_system(self, system: UncertainSystem, F: ArrayLike | None = None) -> control.StateSpace:
         """Error system (13)–(15) of this filter on ``system`` at uncertainty F."""
         Ap = system.A if F is None else system.perturbed_A(F)
         return error_system(Ap, system.B, system.C, system.D, system.L, self.A_F, self.B_F, self.C_F, self.dt)

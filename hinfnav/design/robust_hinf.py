@@ -46,13 +46,18 @@ Nothing here knows about a paper's scenario: the uncertain system comes in as
 matrices, the uncertainty samples as a :class:`~hinfnav.design.SampleSet`.
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.certificates import schur_gamma
 from ..analysis.error_system import WorstCase, worst_case_norm
@@ -73,8 +78,14 @@ from .explain import infeasibility_hint
 from .polytopic import observer_nominal
 from .result import SynthesisResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
-from .tighten import best_candidate as _best, brl_solvers as _brl_solvers, full_lyapunov_gamma, is_loose, key as _key
+from .tighten import best_candidate as _best
+from .tighten import brl_solvers as _brl_solvers
+from .tighten import full_lyapunov_gamma, is_loose
+from .tighten import key as _key
 from .tighten import try_harder as _try_harder
+
+if TYPE_CHECKING:
+    from .samples import SampleSet
 
 __all__ = ["FORMS", "synthesize"]
 
@@ -185,24 +196,11 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
     return _Check(True, "certified", gamma_c, A_F, B_F, C_F, wc, variables)
 
 
-def synthesize(
-    A,
-    B,
-    C,
-    D,
-    L,
-    H=None,
-    E=None,
-    *,
-    dt=True,
-    structure="full",
-    uncertainty_samples=None,
-    n_random_samples=4,
-    seed=0,
-    form="general",
-    options=None,
-    solver=None,
-):
+def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
+               E: ArrayLike | None = None, *, dt: float | bool = True, structure: str = "full",
+               uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
+               seed: int | np.random.Generator = 0, form: str = "general", options: SolverOptions | None = None,
+               solver: str | None = None) -> SynthesisResult:
     """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
 
     Parameters

@@ -5,14 +5,22 @@ for a family parametrized by one scalar (the orbital-rate error δ of Sun et
 al. 2011), the parameter value of each sample and its bound.
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .explain import unstable_plant_message
+
+if TYPE_CHECKING:
+    from ..systems.uncertain import UncertainSystem
 
 __all__ = ["SampleSet", "default_uncertainty_samples", "check_samples", "check_plant"]
 
@@ -57,7 +65,8 @@ class SampleSet:
 
 
 
-def default_uncertainty_samples(system, structure="full", n_random=4, seed=0, max_vertices=64):
+def default_uncertainty_samples(system: UncertainSystem, structure: str = "full", n_random: int = 4,
+                                seed: int | np.random.Generator = 0, max_vertices: int = 64) -> list[NDArray[np.float64] | None]:
     """Uncertainty matrices F at which a design is checked.
 
     F = 0, ±I, the sign vertices ``diag(±1)`` of a diagonal F (all of them
@@ -104,7 +113,8 @@ def default_uncertainty_samples(system, structure="full", n_random=4, seed=0, ma
     return out
 
 
-def check_samples(samples, system, structure):
+def check_samples(samples: Iterable[ArrayLike | None], system: UncertainSystem,
+                  structure: str) -> list[NDArray[np.float64] | None]:
     if system.H is None:
         return [None]
     shape = (system.H.shape[1], system.E.shape[0])
@@ -126,7 +136,8 @@ def check_samples(samples, system, structure):
     return checked
 
 
-def check_plant(system, samples, labels=None):
+def check_plant(system: UncertainSystem, samples: Sequence[NDArray[np.float64] | None],
+                labels: Sequence[str] | None = None) -> None:
     """Raise UnstablePlantError unless A and every A + H F E sampled are Schur stable (internal)."""
     rho = spectral_radius(system.A)
     if not rho < 1.0:

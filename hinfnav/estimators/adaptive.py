@@ -36,11 +36,19 @@ carries the unit s per unit of the augmented state. Before m steps have
 passed κ uses the steps available.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import matmul_shared
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
+
+if TYPE_CHECKING:
+    from .base import FilterState
 
 __all__ = [
     "RateAdaptive",
@@ -187,7 +195,8 @@ class StrongTracking:
     data_dependent_covariance = True
     defers_prior = True
 
-    def __init__(self, *args, rho=0.95, beta=1.0, a=None, **kwargs):
+    def __init__(self, *args: Any, rho: float = 0.95, beta: float = 1.0, a: ArrayLike | None = None,
+                 **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         if getattr(self, "R", None) is None:
             raise InputError("strong tracking needs a constant R (N of (S2) subtracts β R); give R to the filter")
@@ -198,7 +207,8 @@ class StrongTracking:
             raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
         self.a = a
 
-    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+    def complete_prior(self, PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], state: FilterState, innovation: NDArray[np.float64], H: NDArray[np.float64],
+                       mask: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:
         """(S1)-(S4). With missing channels (``~mask``; innovation and H zero there) the moment and N use the
         channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
         V0_old = state.extra.get("V0")
@@ -227,7 +237,7 @@ class StrongTracking:
                 raise InputError(f"runs must equal the number of per-run values of {key} ({val.size}); got {runs}")
         return super()._start(xhat0, P0, runs)
 
-    def initial_diagnostics(self, runs):
+    def initial_diagnostics(self, runs: int) -> dict[str, Any]:
         out = super().initial_diagnostics(runs)
         out.update(fading=np.ones((runs, self.n_cov)), fading_c=np.full(runs, np.nan))
         return out
@@ -252,14 +262,14 @@ class RateAdaptive:
 
     data_dependent_covariance = True
 
-    def __init__(self, *args, window=60, epsilon=1.0, floor=1.0, **kwargs):
+    def __init__(self, *args: Any, window: int = 60, epsilon: float = 1.0, floor: float = 1.0, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.window = as_int_at_least("window", window, 1)
         self.epsilon = per_run_parameter("epsilon", epsilon, as_positive)
         self.floor = as_nonnegative("floor", floor)
         self._Q0_diag = np.diag(self.Q).copy()
 
-    def process_noise(self, state):
+    def process_noise(self, state: FilterState) -> tuple[NDArray[np.float64], dict[str, Any]]:
         extra = state.extra
         kappa = input_rate(extra["rate_window"], extra["rate_count"], self.window, self.dt)
         q = rate_adapted_density(self._Q0_diag, kappa, self.epsilon, self.floor)
@@ -272,13 +282,13 @@ class RateAdaptive:
         state.extra.update(rate_window=window, rate_count=0)
         return state
 
-    def after_update(self, state, x_post):
+    def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
         window = state.extra["rate_window"].copy()
         count = state.extra["rate_count"]
         window[count % (self.window + 1)] = self.augmented(x_post)
         return {"rate_window": window, "rate_count": count + 1}
 
-    def step_diagnostics(self, state):
+    def step_diagnostics(self, state: FilterState) -> dict[str, Any]:
         out = super().step_diagnostics(state)
         runs = state.x.shape[0]
         q = state.extra.get("q_used")

@@ -31,7 +31,12 @@ contract suite); the input estimate is in the diagnostics
 its covariance is shared by every run.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance, congruence
@@ -40,6 +45,10 @@ from .adaptive import RateAdaptive, StrongTracking
 from .base import FilterState
 from .huber_filter import HuberCorrection
 from .kalman import OUTPUTS, KalmanCore
+
+if TYPE_CHECKING:
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputHuberSTKF", "AugmentedInputKF",
            "AugmentedInputSTKF"]
@@ -83,8 +92,9 @@ class AugmentedEKF(KalmanCore):
     refuse_nonfinite = True
     transient_keys = _TRANSIENT
 
-    def __init__(self, system, measurement, *, n_cov, aug_input, P0, Q, base_noise=None, R=None, uses_input=False,
-                 output="filtered", name=None, missing="refuse"):
+    def __init__(self, system: Any, measurement: MeasurementModel, *, n_cov: int, aug_input: int, P0: ArrayLike,
+                 Q: ArrayLike, base_noise: ArrayLike | None = None, R: ArrayLike | None = None, uses_input: bool = False,
+                 output: str = "filtered", name: str | None = None, missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         self.n_cov = int(n_cov)
         self.E = np.asarray(aug_input, dtype=float)
@@ -108,7 +118,7 @@ class AugmentedEKF(KalmanCore):
         self.Qd = self.base_noise + self.dt * self.E @ self.Q @ self.E.T
 
     @property
-    def parameter_runs(self):
+    def parameter_runs(self) -> int | None:
         """Number of runs a per-run parameter fixes (Q, or an idea's ρ, β, ε), or None."""
         sizes = {self.Q.shape[0]} if self.Q.ndim == 3 else set()
         for key in ("rho", "beta", "epsilon"):
@@ -120,43 +130,43 @@ class AugmentedEKF(KalmanCore):
         return sizes.pop() if sizes else None
 
     @property
-    def shares_covariance(self):
+    def shares_covariance(self) -> bool:
         """True when P and the gain do not depend on the data (linear model, no adaptive idea, one Q)."""
         return self.linear_model and not self.data_dependent_covariance and self.parameter_runs is None
 
     # -- model hooks (subclasses) ------------------------------------------------
 
-    def initial_internal(self, xhat0):
+    def initial_internal(self, xhat0: NDArray[np.float64]) -> NDArray[np.float64]:
         """Internal state from the reported prior estimate, shape (n_x,)."""
         raise NotImplementedError
 
-    def propagate_mean(self, x, u):
+    def propagate_mean(self, x: NDArray[np.float64], u: NDArray[np.float64] | None) -> NDArray[np.float64]:
         """``f(x̂, u)`` for a batch, shape (runs, n_x)."""
         raise NotImplementedError
 
-    def transition(self, x, u):
+    def transition(self, x: NDArray[np.float64], u: NDArray[np.float64] | None) -> NDArray[np.float64]:
         """Φ of the error coordinates at the posterior, (n_cov, n_cov) or (runs, n_cov, n_cov)."""
         raise NotImplementedError
 
-    def inject(self, x, dx):
+    def inject(self, x: NDArray[np.float64], dx: NDArray[np.float64]) -> NDArray[np.float64]:
         """The internal state corrected by ``dx`` (error coordinates)."""
         raise NotImplementedError
 
-    def report(self, x):
+    def report(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The estimate reported in the system's coordinates, (runs, system.n)."""
         raise NotImplementedError
 
-    def augmented(self, x):
+    def augmented(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The augmented states' estimate, (runs, n_aug)."""
         raise NotImplementedError
 
     # -- idea hooks (see hinfnav.estimators.adaptive) ---------------------------------
 
-    def process_noise(self, state):
+    def process_noise(self, state: FilterState) -> tuple[NDArray[np.float64], dict[str, Any]]:
         """``(Q_d, extra)`` for the step from ``state`` (E1); constant here."""
         return self.Qd, {}
 
-    def update_diagnostics(self, x_post):
+    def update_diagnostics(self, x_post: NDArray[np.float64]) -> dict[str, Any]:
         """The augmented states' estimate after the update, ``input_estimate`` (runs, n_aug)."""
         return {"input_estimate": self.augmented(x_post)}
 
@@ -215,8 +225,9 @@ class AugmentedInputKF(AugmentedEKF):
 
     name = "augmented input kf"
 
-    def __init__(self, system, measurement, *, Q_input, P0, P0_input=None, Q=None, R=None, output="filtered", name=None,
-                 missing="refuse"):
+    def __init__(self, system: LinearSystem, measurement: MeasurementModel, *, Q_input: ArrayLike, P0: ArrayLike,
+                 P0_input: ArrayLike | None = None, Q: ArrayLike | None = None, R: ArrayLike | None = None, output: str = "filtered",
+                 name: str | None = None, missing: str = "refuse") -> None:
         for attr in ("Phi", "Gamma"):
             if not hasattr(system, attr):
                 raise InputError(f"system must be a hinfnav LinearSystem (with Phi, Gamma); got {type(system).__name__}")
@@ -239,16 +250,16 @@ class AugmentedInputKF(AugmentedEKF):
         if self.linear_model:
             self._H = np.hstack([measurement.H, np.zeros((measurement.n_meas, m))])
 
-    def initial_internal(self, xhat0):
+    def initial_internal(self, xhat0: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.concatenate([xhat0, np.zeros(self.n_aug)])
 
-    def propagate_mean(self, x, u):
+    def propagate_mean(self, x: NDArray[np.float64], u: NDArray[np.float64] | None) -> NDArray[np.float64]:
         return x @ self.Phi_a.T
 
-    def transition(self, x, u):
+    def transition(self, x: NDArray[np.float64], u: NDArray[np.float64] | None) -> NDArray[np.float64]:
         return self.Phi_a
 
-    def observe(self, x):
+    def observe(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         xs = x[:, : self._n]
         yhat = self.measurement.function(xs)
         if self.linear_model:
@@ -256,16 +267,16 @@ class AugmentedInputKF(AugmentedEKF):
         J = self.measurement.jacobian(xs)
         return yhat, np.concatenate([J, np.zeros(J.shape[:-1] + (self.n_aug,))], axis=-1)
 
-    def inject(self, x, dx):
+    def inject(self, x: NDArray[np.float64], dx: NDArray[np.float64]) -> NDArray[np.float64]:
         return x + dx
 
-    def report(self, x):
+    def report(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         return x[:, : self._n]
 
-    def report_covariance(self, P):
+    def report_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
         return P[..., : self._n, : self._n]
 
-    def augmented(self, x):
+    def augmented(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         return x[:, self._n:]
 
 

@@ -37,12 +37,22 @@ filter the covariance prediction, an augmented filter the system it is built
 on, a saturated-measurement filter the update when a channel is clipped.
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_vector
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
            "MISSING", "PHASES", "available_channels"]
@@ -101,7 +111,7 @@ class FilterState:
     phase: str = "prior"
 
     @property
-    def runs(self):
+    def runs(self) -> int:
         return self.x.shape[0]
 
 
@@ -144,12 +154,12 @@ class EstimateHistory:
     diagnostics: dict = field(default_factory=dict)
 
     @property
-    def labels(self):
+    def labels(self) -> tuple[str, ...] | None:
         """State labels (from the system)."""
         return None if self.state is None else self.state.labels
 
     @property
-    def units(self):
+    def units(self) -> tuple[str, ...] | None:
         """State units (from the system)."""
         return None if self.state is None else self.state.units
 
@@ -170,7 +180,8 @@ def history_keys(keep_covariance, diagnostics):
         raise InputError(f"diagnostics must be True, False or names of diagnostics; got {diagnostics!r}") from None
 
 
-def check_estimator_inputs(y, u, xhat0, n_state, n_meas=None, n_input=None, missing="refuse"):
+def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, n_state: int, n_meas: int | None = None,
+                           n_input: int | None = None, missing: str = "refuse") -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64]]:
     """Validate the arguments of :meth:`Estimator.estimate`; return float arrays.
 
     With ``missing="skip"`` a NaN in y marks a missing channel (inf is still refused).
@@ -221,7 +232,8 @@ class Estimator:
     uses_input = False
     vectorized = True
 
-    def __init__(self, system, measurement, *, name=None, missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, name: str | None = None,
+                 missing: str = "refuse") -> None:
         for attr in ("n", "dt", "state"):
             if not hasattr(system, attr):
                 raise InputError(f"system must be a hinfnav system (with n, dt, state); got {type(system).__name__}")
@@ -236,34 +248,34 @@ class Estimator:
         self.missing = missing
 
     @property
-    def missing(self):
+    def missing(self) -> str:
         """Policy for NaN channels of a reading: "refuse" (an InputError) or "skip" (see :meth:`update`)."""
         return self._missing
 
     @missing.setter
-    def missing(self, value):
+    def missing(self, value: str) -> None:
         self._missing = as_choice("missing", value, MISSING)
 
     # -- dimensions ---------------------------------------------------------
 
     @property
-    def n_state(self):
+    def n_state(self) -> int:
         """Dimension of the estimated state."""
         return self.system.n
 
     @property
-    def n_input(self):
+    def n_input(self) -> int:
         """Number of input channels the estimator accepts."""
         return getattr(self.system, "n_input", 0)
 
     @property
-    def dt(self):
+    def dt(self) -> float:
         """Sampling time, s."""
         return self.system.dt
 
     # -- the step contract: checked public calls ------------------------------
 
-    def start(self, xhat0, P0=None, runs=1):
+    def start(self, xhat0: ArrayLike, P0: ArrayLike | None = None, runs: int = 1) -> FilterState:
         """Initial filter state for ``runs`` runs, with prior estimate ``xhat0`` (shape (n,)).
 
         ``P0`` (a finite square matrix; its size is the filter's covariance
@@ -280,7 +292,7 @@ class Estimator:
                 raise InputError("P0 must contain only finite numbers; it has NaN or inf entries")
         return self._phase(self._start(xhat0, P0, runs), None, "prior")
 
-    def update(self, state, y):
+    def update(self, state: FilterState, y: ArrayLike) -> tuple[FilterState, StepOutput]:
         """Consume y_k (shape (runs, n_meas)); return ``(state, StepOutput)``.
 
         Checks the call order (after ``start`` or ``predict``), the shape of
@@ -305,7 +317,7 @@ class Estimator:
         new, out = self._update(state, y)
         return self._phase(new, state, "posterior"), out
 
-    def predict(self, state, u=None):
+    def predict(self, state: FilterState, u: ArrayLike | None = None) -> FilterState:
         """Propagate to t_{k+1} with the input u_k (shape (runs, n_input)); return the state.
 
         Checks the call order (after ``update``) and u: required when the
@@ -315,7 +327,7 @@ class Estimator:
         u = self._check_step_input(state, u, "predict")
         return self._phase(self._predict(state, u), state, "prior")
 
-    def step(self, state, y, u=None):
+    def step(self, state: FilterState, y: ArrayLike, u: ArrayLike | None = None) -> tuple[FilterState, StepOutput]:
         """``update`` with y_k, then ``predict`` with u_k; returns ``(state, StepOutput)``."""
         state, out = self.update(state, y)
         return self.predict(state, u), out
@@ -380,7 +392,8 @@ class Estimator:
 
     # -- batch --------------------------------------------------------------
 
-    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
+    def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
+                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False) -> EstimateHistory:
         """Estimate the state histories of a batch of runs.
 
         Parameters

@@ -22,7 +22,12 @@ shared P stays shared. The Huber regression on such rows is exact as well:
 a zero row of the whitened regression has residual 0 whatever the state.
 """
 
+from __future__ import annotations
+
+from typing import Any
+
 import numpy as np
+from numpy.typing import NDArray
 
 from ..core.linalg import inv_spd, matmul_shared
 
@@ -33,7 +38,8 @@ def _swap(M):
     return np.swapaxes(M, -1, -2)
 
 
-def drop_missing(P, H, R, innovation, mask):
+def drop_missing(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64],
+                 mask: NDArray[np.bool_] | None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """``(P, H, R, innovation)`` with the channels ``~mask`` removed exactly (see the module docstring).
 
     Parameters
@@ -68,7 +74,7 @@ def drop_missing(P, H, R, innovation, mask):
     return P, H, R, innovation
 
 
-def kalman_gain(P, H, R, *, symmetrize=True):
+def kalman_gain(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], *, symmetrize: bool = True) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Gain and Joseph-form posterior covariance (J1)-(J2), batched; returns ``(K, P⁺, S)``.
 
     Shapes as in :func:`joseph_update`; K is (n, m) when P, H and R are shared,
@@ -88,7 +94,8 @@ def kalman_gain(P, H, R, *, symmetrize=True):
     return K, P_post, S
 
 
-def joseph_update(P, H, R, innovation, *, symmetrize=True):
+def joseph_update(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64], *,
+                  symmetrize: bool = True) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The Kalman correction (J1)-(J2), batched; returns ``(δx, P⁺, S)``.
 
     Parameters
@@ -128,7 +135,7 @@ class KalmanCorrection:
     #: Return the symmetric part of P⁺ (the augmented core) or (J2) as computed (the EKF).
     symmetric_posterior = True
 
-    def correct_error(self, P, H, R, innovation):
+    def correct_error(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         dx, P_post, S = joseph_update(P, H, R, innovation, symmetrize=self.symmetric_posterior)
         runs = innovation.shape[0]
         return dx, P_post, {"innovation_covariance": S if S.ndim == 3 else np.broadcast_to(S, (runs,) + S.shape)}

@@ -43,9 +43,12 @@ the whole regression. Both give the same minimiser (tested against cvxpy to
 1e-8 and against the whole-regression solver).
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
 from ..core.linalg import inv_spd, matmul_shared
@@ -125,7 +128,8 @@ def _cholesky(name, C):
         raise InputError(f"{name} must be positive definite; its Cholesky factorisation fails") from None
 
 
-def huber_update(x_prior, P_prior, z, H, R, *, gamma=1.345, tol=1e-10, max_iter=50):
+def huber_update(x_prior: ArrayLike, P_prior: ArrayLike, z: ArrayLike, H: ArrayLike, R: ArrayLike, *,
+                 gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50) -> HuberUpdate:
     """Huber M-estimate measurement update, batched over runs.
 
     Parameters

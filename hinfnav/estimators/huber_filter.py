@@ -27,12 +27,22 @@ rows), ``iterations`` and ``converged`` of the M-estimation, and the
 ``innovation``.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive
 from .huber import huber_correct, whitening
 from .kalman import ExtendedKalmanFilter
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["HuberCorrection", "HuberFilter"]
 
@@ -51,7 +61,7 @@ class HuberCorrection:
 
     data_dependent_covariance = True
 
-    def __init__(self, *args, gamma=1.345, tol=1e-10, max_iter=50, **kwargs):
+    def __init__(self, *args: Any, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.gamma = as_positive("gamma", gamma)
         self.tol = as_positive("tol", tol)
@@ -59,11 +69,11 @@ class HuberCorrection:
         self._LRi = None if self.R is None else whitening(self.R)  # constant R: whitened once
 
     @property
-    def shares_covariance(self):
+    def shares_covariance(self) -> bool:
         """Always False: the Huber weights, hence P, depend on the data."""
         return False
 
-    def correct_error(self, P, H, R, innovation):
+    def correct_error(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """Huber M-estimation of the correction δx; returns ``(δx, P⁺, diagnostics)`` (P per run)."""
         if P.ndim == 2:
             P = np.broadcast_to(P, (innovation.shape[0],) + P.shape)
@@ -100,13 +110,16 @@ class HuberFilter(HuberCorrection, ExtendedKalmanFilter):
 
     name = "hbf"
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, gamma=1.345, tol=1e-10, max_iter=50,
-                 uses_input=False, output="filtered", name=None, missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
+                 R: ArrayLike | None = None, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50,
+                 uses_input: bool = False, output: str = "filtered", name: str | None = None,
+                 missing: str = "refuse") -> None:
         super().__init__(system, measurement, P0=P0, Q=Q, R=R, uses_input=uses_input, output=output, name=name,
                          missing=missing, gamma=gamma, tol=tol, max_iter=max_iter)
 
     @classmethod
-    def from_ekf(cls, ekf, *, gamma=1.345, tol=1e-10, max_iter=50, name=None):
+    def from_ekf(cls, ekf: ExtendedKalmanFilter, *, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50,
+                 name: str | None = None) -> HuberFilter:
         """The Huber-based version of an :class:`~hinfnav.estimators.ExtendedKalmanFilter`.
 
         Same system, measurement, P₀, Q, R (or reading-dependent R), input

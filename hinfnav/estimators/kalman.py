@@ -31,7 +31,12 @@ The update follows filterpy's ``ExtendedKalmanFilter.update`` step for step
 (Joseph form), which the test suite checks run by run.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
@@ -39,6 +44,11 @@ from ..core.validation import as_choice
 from .adaptive import StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "StrongTrackingEKF"]
 
@@ -75,35 +85,36 @@ class KalmanCore(KalmanCorrection, Estimator):
     R_of_reading = None
 
     @property
-    def n_cov(self):
+    def n_cov(self) -> int:
         """Dimension of the error coordinates (and of P): the state's unless set otherwise (augmented states)."""
         return getattr(self, "_n_cov", None) or self.n_state
 
     @n_cov.setter
-    def n_cov(self, value):
+    def n_cov(self, value: int) -> None:
         self._n_cov = int(value)
 
     # -- model hooks ---------------------------------------------------------------
 
-    def observe(self, x):
+    def observe(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(ŷ, H)`` at the prior: ŷ (runs, m), H (m, n_cov) or (runs, m, n_cov)."""
         raise NotImplementedError
 
-    def inject(self, x, dx):
+    def inject(self, x: NDArray[np.float64], dx: NDArray[np.float64]) -> NDArray[np.float64]:
         """The state corrected by ``dx`` (error coordinates); additive here."""
         return x + dx
 
-    def report(self, x):
+    def report(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The estimate reported in the system's coordinates, (runs, system.n)."""
         return x
 
-    def report_covariance(self, P):
+    def report_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
         """The covariance reported with the estimate."""
         return P
 
     # -- idea hooks ----------------------------------------------------------------------
 
-    def complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=None):
+    def complete_prior(self, PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], state: FilterState, innovation: NDArray[np.float64], H: NDArray[np.float64],
+                       mask: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:
         """``(P(k+1|k), diagnostics, extra)`` at the reading y(k+1): ``F P Fᵀ + Q_d`` here.
 
         Called only when :attr:`defers_prior` is set; ``innovation`` and ``H``
@@ -112,23 +123,23 @@ class KalmanCore(KalmanCorrection, Estimator):
         """
         return PhiPPhiT + Qd, {}, {}
 
-    def initial_diagnostics(self, runs):
+    def initial_diagnostics(self, runs: int) -> dict[str, Any]:
         """Diagnostics every step reports, at their values before any prediction (none here)."""
         return {}
 
-    def step_diagnostics(self, state):
+    def step_diagnostics(self, state: FilterState) -> dict[str, Any]:
         """Diagnostics that depend on the prior ``state`` (none here)."""
         return {}
 
-    def update_diagnostics(self, x_post):
+    def update_diagnostics(self, x_post: NDArray[np.float64]) -> dict[str, Any]:
         """Diagnostics that depend on the posterior estimate (none here)."""
         return {}
 
-    def after_update(self, state, x_post):
+    def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
         """Extra items to keep after an update (none here)."""
         return {}
 
-    def measurement_covariance(self, y, x):
+    def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
 
         None means the constant :attr:`R` (and :meth:`correct` is called
@@ -136,7 +147,8 @@ class KalmanCore(KalmanCorrection, Estimator):
         """
         return None if self.R_of_reading is None else self.R_of_reading(y)
 
-    def correct(self, x, P, H, innovation, state, R=None):
+    def correct(self, x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64], innovation: NDArray[np.float64], state: FilterState,
+                R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """The correction :meth:`correct_error` (Joseph form here, Huber's with the Huber mixin) applied to x.
 
         Returns ``(x⁺, P⁺, diagnostics)``; ``H`` is (m, n) when P is shared,
@@ -231,8 +243,9 @@ class ExtendedKalmanFilter(KalmanCore):
     name = "ekf"
     symmetric_posterior = False
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, uses_input=False, output="filtered", name=None,
-                 missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
+                 R: ArrayLike | None = None, uses_input: bool = False, output: str = "filtered", name: str | None = None,
+                 missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         n, m = system.n, measurement.n_meas
         self.Q = as_covariance("Q", system.Q if Q is None else Q, n, definite=False)
@@ -261,14 +274,14 @@ class ExtendedKalmanFilter(KalmanCore):
         self.Gamma = getattr(system, "Gamma", None)
 
     @property
-    def shares_covariance(self):
+    def shares_covariance(self) -> bool:
         """True when P and the gain do not depend on the data (linear measurement, constant R)."""
         return (bool(self.measurement.linear) and self.R_of_reading is None and not self.nonlinear_dynamics
                 and not self.data_dependent_covariance)
 
     # -- hooks ------------------------------------------------------------------
 
-    def predict_mean(self, x, u, t=0.0):
+    def predict_mean(self, x: NDArray[np.float64], u: NDArray[np.float64] | None, t: float = 0.0) -> NDArray[np.float64]:
         """``Φ x̂ (+ Γ u)`` for a batch of estimates, or the dynamics model's ``f(x̂, u, t)`` (t the time of x̂, s)."""
         if self.nonlinear_dynamics:
             return self.system.f(x, u if self.uses_input else None, t)
@@ -277,22 +290,22 @@ class ExtendedKalmanFilter(KalmanCore):
             out = out + u @ self.Gamma.T
         return out
 
-    def predict_covariance(self, P, state, F=None):
+    def predict_covariance(self, P: NDArray[np.float64], state: FilterState, F: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """``F P Fᵀ + Q`` with F = Φ, or the dynamics model's Jacobian at x̂(k|k) ((n, n) or (runs, n, n))."""
         return self.propagated_covariance(P, F) + self.Q
 
-    def propagated_covariance(self, P, F=None):
+    def propagated_covariance(self, P: NDArray[np.float64], F: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """``F P Fᵀ`` without the process noise (F = Φ, or the dynamics model's Jacobian, (runs, n, n))."""
         F = self.F if F is None else F
         if F.ndim == 3:
             return F @ P @ np.swapaxes(F, -1, -2)
         return congruence(F, P)
 
-    def observe(self, x):
+    def observe(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(h(x̂⁻), H)``: H at one prior when the covariance is shared, else per run."""
         return self.measurement.function(x), self.measurement.jacobian(x[0] if self.shares_covariance else x)
 
-    def process_noise(self, state):
+    def process_noise(self, state: FilterState) -> tuple[NDArray[np.float64], dict[str, Any]]:
         """``(Q_d, extra)``: the process noise of the step from ``state`` (constant :attr:`Q` here)."""
         return self.Q, {}
 

@@ -1,11 +1,22 @@
 """The fixed full-order LTI filter (12) of Sun et al. (2011), on the step contract."""
 
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["LTIFilter"]
 
@@ -52,7 +63,8 @@ class LTIFilter(Estimator):
     state is ``x_f(0) = C_F⁻¹ x̂(0)`` so that the first estimate is x̂(0).
     """
 
-    def __init__(self, A_F, B_F, C_F, system, measurement, *, name="lti", input_matrix=None, K=None, missing="refuse"):
+    def __init__(self, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, system: LinearSystem | DynamicsModel, measurement: MeasurementModel,
+                 *, name: str = "lti", input_matrix: ArrayLike | None = None, K: ArrayLike | None = None, missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         n = system.n
         self.A_F = as_matrix("A_F", A_F, (n, n))
@@ -83,7 +95,7 @@ class LTIFilter(Estimator):
             )
 
     @property
-    def n_input(self):
+    def n_input(self) -> int:
         return 0 if self._M is None else self._M.shape[1]
 
     def _start(self, xhat0, P0, runs):
@@ -109,7 +121,8 @@ class LTIFilter(Estimator):
         x = state.x @ self._A_eff.T + self._drive(state.extra["y"], u)
         return FilterState(x=x, k=state.k + 1)
 
-    def estimate(self, y, u, xhat0, P0=None, *, keep_covariance=True, diagnostics=False):
+    def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
+                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False) -> EstimateHistory:
         """Vectorized over runs and fast: same numbers as the step loop (bitwise)."""
         history_keys(keep_covariance, diagnostics)  # checked; the filter has neither a covariance nor diagnostics
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,

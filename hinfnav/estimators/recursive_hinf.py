@@ -33,13 +33,23 @@ instead of ``F x̂ + F K (y − H x̂)``. With F = I the two coincide
 (``tests/test_recursive_hinf.py`` checks both statements).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..analysis.hinf_riccati import max_admissible_theta
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
 from .base import Estimator, FilterState, StepOutput
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
 
@@ -91,8 +101,9 @@ class RecursiveHInfinityFilter(Estimator):
 
     name = "recursive_hinf"
 
-    def __init__(self, system, measurement, *, theta, P0, Q=None, R=None, L=None, S=None, uses_input=True,
-                 on_violation="raise", name=None, missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, theta: float, P0: ArrayLike,
+                 Q: ArrayLike | None = None, R: ArrayLike | None = None, L: ArrayLike | None = None, S: ArrayLike | None = None, uses_input: bool = True,
+                 on_violation: str = "raise", name: str | None = None, missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         if not getattr(measurement, "linear", False) or measurement.H is None:
             raise InputError(f"measurement must be linear (y = H x + D v); got {type(measurement).__name__}")
@@ -119,13 +130,13 @@ class RecursiveHInfinityFilter(Estimator):
 
     # -- the data-independent recursion --------------------------------------------
 
-    def theta_max(self):
+    def theta_max(self) -> float:
         """Largest θ with a steady state (:func:`hinfnav.analysis.max_admissible_theta`), cached."""
         if self._theta_max is None:
             self._theta_max = max_admissible_theta(self.F, self.H, self.Q, self.R, L=self.L, S=self.S)
         return self._theta_max
 
-    def riccati_step(self, P, k=0):
+    def riccati_step(self, P: NDArray[np.float64], k: int = 0) -> tuple[NDArray[np.float64], NDArray[np.float64], float, bool]:
         """One step of the recursion: ``(K, P_next, margin, ok)`` (see the module notes)."""
         try:
             C = np.linalg.cholesky(P)

@@ -13,10 +13,17 @@ call, and :func:`estimator_entry` on an unknown name, so a fresh Python process
 lists and builds every paper's estimators without this layer naming a paper.
 """
 
+from __future__ import annotations
+
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
+from typing import TYPE_CHECKING, Any
 
 from ..core.exceptions import InputError
+
+if TYPE_CHECKING:
+    from .base import Estimator
 
 __all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
            "providers", "PROVIDER_GROUP"]
@@ -40,12 +47,12 @@ PROVIDER_GROUP = "hinfnav.providers"
 _PROVIDERS = {"loaded": False}
 
 
-def providers():
+def providers() -> tuple[str, ...]:
     """The provider modules declared under :data:`PROVIDER_GROUP` by the installed packages."""
     return tuple(ep.value for ep in metadata.entry_points(group=PROVIDER_GROUP))
 
 
-def load_providers():
+def load_providers() -> dict[str, str]:
     """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
     _PROVIDERS["loaded"] = True  # first, so that a provider asking for the registry while it loads does not recurse
     failed = {}
@@ -62,7 +69,8 @@ def _ensure_providers():
         load_providers()
 
 
-def register_estimator(name, builder, *, fits=None, description=""):
+def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Callable[[Any], bool] | None = None,
+                       description: str = "") -> None:
     """Register ``builder(scenario, **options) -> Estimator`` under ``name``.
 
     Parameters
@@ -82,7 +90,7 @@ def register_estimator(name, builder, *, fits=None, description=""):
     _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description)
 
 
-def registered_estimators(scenario=None):
+def registered_estimators(scenario: Any = None) -> tuple[str, ...]:
     """Names of the registered estimators (that fit ``scenario`` when given), in registration order.
 
     The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
@@ -91,7 +99,7 @@ def registered_estimators(scenario=None):
     return tuple(n for n, e in _REGISTRY.items() if scenario is None or e.fits(scenario))
 
 
-def estimator_entry(name):
+def estimator_entry(name: str) -> _Entry:
     """The registry entry of ``name`` (builder, fits, description); an unknown name loads the providers first."""
     if isinstance(name, str) and name not in _REGISTRY:
         _ensure_providers()
@@ -100,7 +108,7 @@ def estimator_entry(name):
     return _REGISTRY[name]
 
 
-def build_estimator(name, scenario, **options):
+def build_estimator(name: str, scenario: Any, **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``."""
     entry = estimator_entry(name)
     if not entry.fits(scenario):

@@ -49,7 +49,12 @@ Diagnostics at each step: ``innovation`` ν (runs, m) and
 ``innovation_covariance`` S (runs, m, m).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, inv_spd
@@ -58,6 +63,11 @@ from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .kalman import OUTPUTS, ExtendedKalmanFilter
+
+if TYPE_CHECKING:
+    from ..systems.dynamics import DynamicsModel
+    from ..systems.linear import LinearSystem
+    from ..systems.measurements import MeasurementModel
 
 __all__ = ["RULES", "SigmaPointFilter", "merwe_weights", "sigma_points"]
 
@@ -119,8 +129,10 @@ class SigmaPointFilter(Estimator):
 
     name = "ukf"
 
-    def __init__(self, system, measurement, *, P0, Q=None, R=None, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0,
-                 uses_input=False, output="filtered", name=None, missing="refuse"):
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
+                 R: ArrayLike | None = None, rule: str = "unscented", alpha: float = 1.0, beta: float = 2.0, kappa: float = 0.0,
+                 uses_input: bool = False, output: str = "filtered", name: str | None = None,
+                 missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         #: True for a state with its own error (a quaternion): sigma points in error coordinates (U6)
         self.error_coordinates = type(system.state).error is not StateSpec.error
@@ -153,7 +165,7 @@ class SigmaPointFilter(Estimator):
         self.output = as_choice("output", output, OUTPUTS)
 
     @classmethod
-    def from_ekf(cls, ekf, *, name=None, **options):
+    def from_ekf(cls, ekf: ExtendedKalmanFilter, *, name: str | None = None, **options: Any) -> SigmaPointFilter:
         """The sigma-point version of an :class:`~hinfnav.estimators.ExtendedKalmanFilter`.
 
         Same system, measurement, P₀, Q, R (or reading-dependent R), input use

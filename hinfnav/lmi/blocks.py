@@ -5,15 +5,27 @@ expressions (``bmat=cvxpy.bmat``: the solver), so the certificate evaluates
 exactly the matrix the solver was given.
 """
 
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix
 
+if TYPE_CHECKING:
+    import cvxpy as cp
+
 __all__ = ["lmi20_matrix", "observer_lmi_matrix", "gamma_index", "error_system_matrices"]
 
 
-def lmi20_matrix(A, B, C, D, L, H, E, R, S, Abar_F, Bbar_F, Cbar_F, lam, gamma2, bmat=np.block):
+def lmi20_matrix(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None,
+                 E: ArrayLike | None, R: ArrayLike | cp.Expression, S: ArrayLike | cp.Expression, Abar_F: ArrayLike | cp.Expression, Bbar_F: ArrayLike | cp.Expression,
+                 Cbar_F: ArrayLike | cp.Expression, lam: float | cp.Expression, gamma2: float | cp.Expression,
+                 bmat: Callable[..., Any] = np.block) -> NDArray[np.float64] | cp.Expression:
     """The matrix of LMI (20) (Theorem 1), negative definite iff the bound holds.
 
     Block rows/columns: ``[n, n, n, n, p, q, l, r]`` (the last one only when
@@ -77,7 +89,9 @@ def lmi20_matrix(A, B, C, D, L, H, E, R, S, Abar_F, Bbar_F, Cbar_F, lam, gamma2,
     return bmat(rows)
 
 
-def observer_lmi_matrix(A, B, C, D, L, H, E, X, S, Bbar_F, lam, gamma2, bmat=np.block):
+def observer_lmi_matrix(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None,
+                        E: ArrayLike | None, X: ArrayLike | cp.Expression, S: ArrayLike | cp.Expression, Bbar_F: ArrayLike | cp.Expression,
+                        lam: float | cp.Expression, gamma2: float | cp.Expression, bmat: Callable[..., Any] = np.block) -> NDArray[np.float64] | cp.Expression:
     """LMI (20) for an observer-form filter, in error coordinates (congruent to (20)).
 
     With the observer constraints ``Ā_F = S A + B̄_F C`` and ``C̄_F = −L``
@@ -146,7 +160,7 @@ def observer_lmi_matrix(A, B, C, D, L, H, E, X, S, Bbar_F, lam, gamma2, bmat=np.
     return bmat(rows)
 
 
-def gamma_index(n, p, q):
+def gamma_index(n: int, p: int, q: int) -> NDArray[np.intp]:
     return np.arange(4 * n, 4 * n + p + q)
 
 

@@ -12,15 +12,22 @@
   exactly (see :func:`normalize`).
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_matrix
+
+if TYPE_CHECKING:
+    from ..systems.uncertain import UncertainSystem
 
 __all__ = [
     "Prepared",
@@ -35,7 +42,7 @@ __all__ = [
 ]
 
 
-def pow2(x):
+def pow2(x: float) -> float:
     """Nearest power of two (exact scaling in floating point)."""
     return float(2.0 ** round(math.log2(x)))
 
@@ -59,18 +66,19 @@ class Prepared:
     nu: float = 1.0  # L above is the state-scaled one divided by nu (a power of two)
 
     @property
-    def normalized(self):
+    def normalized(self) -> bool:
         """Whether the noise or output blocks are normalised (ρ ≠ 1 or ν ≠ 1)."""
         return self.rho != 1.0 or self.nu != 1.0
 
-    def unnormalized(self):
+    def unnormalized(self) -> Prepared:
         """The same data with the normalisation of :func:`normalize` undone (exact: powers of two)."""
         if not self.normalized:
             return self
         return dataclasses.replace(self, B=self.B * self.rho, D=self.D * self.rho, L=self.L * self.nu, rho=1.0, nu=1.0)
 
 
-def prepare_uncertainty(H, E, structure="diagonal", tol=0.0):
+def prepare_uncertainty(H: ArrayLike, E: ArrayLike, structure: str = "diagonal", tol: float = 0.0
+                        ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None, tuple[NDArray[np.intp], NDArray[np.intp]]]:
     """Drop the zero columns of H / rows of E and balance the factorization.
 
     Parameters
@@ -125,7 +133,7 @@ def prepare_uncertainty(H, E, structure="diagonal", tol=0.0):
     return Hk * s, Ek / s, (kh, ke)
 
 
-def state_scaling(A, mode):
+def state_scaling(A: ArrayLike, mode: str | ArrayLike) -> NDArray[np.float64]:
     """Powers of two σ_i for the coordinates ``x = diag(σ) x̃`` (internal).
 
     ``"balance"``: LAPACK gebal balancing (``scipy.linalg.matrix_balance``,
@@ -148,7 +156,7 @@ def state_scaling(A, mode):
     return np.array([pow2(v) for v in sca])
 
 
-def prepare(system, structure, scaling, form="general"):
+def prepare(system: UncertainSystem, structure: str, scaling: str | ArrayLike, form: str = "general") -> Prepared:
     H_b = E_b = None
     if system.H is not None:
         H_b, E_b, _ = prepare_uncertainty(system.H, system.E, structure)

@@ -37,11 +37,16 @@ and L to be the same at every vertex (the uncertainty must not multiply the
 plant state); only (A, C) detectable is needed, not a stable A.
 """
 
+from __future__ import annotations
+
 import time
 import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import cvxpy as cp
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .solve import solver_kwargs
 
@@ -49,7 +54,8 @@ __all__ = ["extended_hinf_matrix", "hinf_gamma_index", "solve_polytopic_hinf", "
            "extended_h2_matrices"]
 
 
-def extended_hinf_matrix(P, GA, GB, Cbar, G, gamma2, bmat=np.block):
+def extended_hinf_matrix(P: ArrayLike | cp.Expression, GA: ArrayLike | cp.Expression, GB: ArrayLike | cp.Expression, Cbar: ArrayLike | cp.Expression,
+                         G: ArrayLike | cp.Expression, gamma2: float | cp.Expression, bmat: Callable[..., Any] = np.block) -> NDArray[np.float64] | cp.Expression:
     """The matrix N of (E1) (positive definite iff the bound holds), from the products ``G Ā`` and ``G B̄``.
 
     Block rows/columns ``[N, N, k, l]`` (N states, k inputs, l outputs).
@@ -65,7 +71,8 @@ def extended_hinf_matrix(P, GA, GB, Cbar, G, gamma2, bmat=np.block):
     ])
 
 
-def extended_h2_matrices(P, GA, GB, Cbar, G, W, bmat=np.block):
+def extended_h2_matrices(P: ArrayLike | cp.Expression, GA: ArrayLike | cp.Expression, GB: ArrayLike | cp.Expression, Cbar: ArrayLike | cp.Expression,
+                         G: ArrayLike | cp.Expression, W: ArrayLike | cp.Expression, bmat: Callable[..., Any] = np.block) -> tuple[NDArray[np.float64] | cp.Expression, NDArray[np.float64] | cp.Expression]:
     """The two matrices of the extended H2 LMIs (E2), both positive definite iff ``‖·‖₂² < tr W`` holds with P.
 
     ``Āᵀ P Ā − P + C̄ᵀC̄ < 0`` and ``W > B̄ᵀ P B̄`` (P bounds the observability
@@ -98,8 +105,10 @@ def filter_slack_products(vertex, X, Z, V, Ahat, Bhat, CF, bmat=np.block):
     return GA, GB, Cbar
 
 
-def solve_polytopic_hinf(vertices, form="general", lyapunov="parameter-dependent", solver="CLARABEL",
-                         margin=1e-8, accuracy=1e-8, bound=1e6, gamma2=None, objective="hinf"):
+def solve_polytopic_hinf(vertices: Sequence[Sequence[ArrayLike]], form: str = "general",
+                         lyapunov: str = "parameter-dependent", solver: str = "CLARABEL", margin: float = 1e-8,
+                         accuracy: float = 1e-8, bound: float = 1e6, gamma2: float | None = None,
+                         objective: str = "hinf") -> dict[str, Any]:
     """Minimize γ² subject to (E1) at every vertex; one cvxpy solve.
 
     Parameters

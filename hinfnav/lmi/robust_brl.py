@@ -5,10 +5,13 @@ norm-bounded uncertainty for a given error system; the solution is checked by
 :func:`hinfnav.analysis.certificates.schur_gamma`.
 """
 
+from __future__ import annotations
+
 import warnings
 
 import cvxpy as cp
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..analysis.certificates import LMICertificate, brl_blocks, schur_gamma
 from ..core.linalg import sym
@@ -17,7 +20,9 @@ from .blocks import error_system_matrices
 __all__ = ["robust_bounded_real_lmi"]
 
 
-def robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None, margin=1e-9):
+def robust_bounded_real_lmi(Abar: ArrayLike, Bbar: ArrayLike, Cbar: ArrayLike, Hbar: ArrayLike | None = None,
+                            Ebar: ArrayLike | None = None, solver: str | None = None,
+                            margin: float = 1e-9) -> LMICertificate:
     """Certified upper bound of ``‖C̄(zI − Ā − H̄FĒ)⁻¹B̄‖∞`` over ``FᵀF ≤ I``.
 
     Minimizes γ² subject to the bounded real lemma (Lemma 1, (17)), with the

@@ -5,12 +5,15 @@ solvers, in which order, method, margins, tolerances, bisection, polishing,
 state scaling) in one object, in the manner of dkpy's synthesis strategies.
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
 import numbers
 import time
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import cvxpy as cp
 import numpy as np
@@ -19,6 +22,9 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
 from .conditioning import NORMALIZE_THRESHOLD
+
+if TYPE_CHECKING:
+    from .conditioning import Prepared
 
 __all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SolverOptions", "Solution", "solve_lmi"]
 
@@ -105,7 +111,7 @@ class SolverOptions:
         object.__setattr__(self, "normalize_above", float(na))
 
     @classmethod
-    def only(cls, solver, **changes):
+    def only(cls, solver: str | None, **changes: Any) -> SolverOptions:
         """Options that use one solver only (``None``: the default chain)."""
         if solver is None:
             return cls(**changes)
@@ -141,7 +147,8 @@ def solver_kwargs(solver, accuracy):
     return {}
 
 
-def solve_lmi(P, solver, margin, accuracy, gamma2=None, bound=1e8):
+def solve_lmi(P: Prepared, solver: str, margin: float, accuracy: float, gamma2: float | None = None,
+              bound: float = 1e8) -> Solution:
     """One cvxpy solve of LMI (20) on prepared data (internal).
 
     When ``P`` is normalised (:func:`hinfnav.lmi.conditioning.normalize`),

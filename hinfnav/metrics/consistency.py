@@ -46,15 +46,23 @@ batch; it is composed into the streaming statistics of
 :func:`hinfnav.metrics.monte_carlo_statistics` and of a campaign cell.
 """
 
+from __future__ import annotations
+
 import warnings
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.stats import chi2
 
 from ..core.exceptions import FilterDivergenceWarning, InputError
 from ..core.validation import as_int_at_least
 from .errors import window_mask
+
+if TYPE_CHECKING:
+    from ..sim.montecarlo import SimulationResult
 
 __all__ = [
     "DIVERGENCE_FACTOR",
@@ -77,7 +85,7 @@ NEES_FACTOR = 10.0
 NIS_KEYS = ("innovation", "innovation_covariance")
 
 
-def chi2_bounds(dof, runs=1, level=0.95):
+def chi2_bounds(dof: int, runs: int = 1, level: float = 0.95) -> tuple[float, float]:
     """Two-sided bounds (C3) of the average over ``runs`` runs of a χ²(``dof``) statistic.
 
     Parameters
@@ -123,7 +131,7 @@ def _inverse(C):
     return out
 
 
-def normalized_squared(e, C):
+def normalized_squared(e: ArrayLike, C: ArrayLike) -> NDArray[np.float64]:
     """``eᵀ C⁻¹ e`` over stacks: the NEES (C1) with (error, P), the NIS (C2) with (innovation, S).
 
     Parameters
@@ -150,7 +158,7 @@ def normalized_squared(e, C):
         return np.einsum("...i,...ij,...j->...", e, Ci, e)
 
 
-def initial_scale(e_prior0, P0=None, e0=None):
+def initial_scale(e_prior0: ArrayLike, P0: ArrayLike | None = None, e0: ArrayLike | None = None) -> NDArray[np.float64]:
     """Per-run initial error scale s₀ (see the module docstring), shape (runs,).
 
     Parameters
@@ -188,7 +196,7 @@ class ConsistencyAccumulator:
         Total number of runs.
     """
 
-    def __init__(self, runs):
+    def __init__(self, runs: int) -> None:
         self.runs = as_int_at_least("runs", runs, 1)
         self.t = None
         self.nees_sum = self.nis_sum = None
@@ -199,7 +207,8 @@ class ConsistencyAccumulator:
         self.max_growth = 0.0
         self.added = 0
 
-    def add(self, t, err, P=None, innovation=None, S=None, scale0=None):
+    def add(self, t: NDArray[np.float64], err: NDArray[np.float64], P: NDArray[np.float64] | None = None, innovation: NDArray[np.float64] | None = None,
+            S: NDArray[np.float64] | None = None, scale0: NDArray[np.float64] | None = None) -> None:
         """Add one batch.
 
         Parameters
@@ -248,7 +257,7 @@ class ConsistencyAccumulator:
             self.nis_sum += normalized_squared(nu, _covariance_history(S, nu.shape)).sum(axis=0)
         self.added += b
 
-    def result(self, name="filter"):
+    def result(self, name: str = "filter") -> ConsistencyStatistics:
         """The :class:`ConsistencyStatistics` of the runs added."""
         if self.added != self.runs:
             raise InputError(f"the consistency accumulator was given {self.added} runs of {self.runs}")
@@ -298,16 +307,16 @@ class ConsistencyStatistics:
     name: str = "filter"
 
     @property
-    def nees_bounds(self):
+    def nees_bounds(self) -> tuple[float, float] | None:
         """95 % bounds (C3) of the run-averaged NEES, or None."""
         return None if self.nees is None else chi2_bounds(self.n, self.runs)
 
     @property
-    def nis_bounds(self):
+    def nis_bounds(self) -> tuple[float, float] | None:
         """95 % bounds (C3) of the run-averaged NIS, or None."""
         return None if self.nis is None else chi2_bounds(self.m, self.runs)
 
-    def window(self, window):
+    def window(self, window: Sequence[float]) -> dict[str, Any]:
         """Window mean and fraction of steps inside the bounds, for the NEES and the NIS; a JSON-ready dict."""
         mask = window_mask(self.t, window)
         out = {"window": [float(v) for v in window]}
@@ -321,7 +330,7 @@ class ConsistencyStatistics:
                 out[f"{key}_inside"] = float(np.mean((v >= bounds[0]) & (v <= bounds[1])))
         return out
 
-    def divergence(self, windows=()):
+    def divergence(self, windows: Iterable[Sequence[float]] = ()) -> tuple[bool, list[str]]:
         """``(diverged, reasons)`` by the criteria of the module docstring, over the given windows."""
         reasons = []
         if self.nonfinite_runs:
@@ -341,7 +350,7 @@ class ConsistencyStatistics:
                                    f"times its 95 % upper bound {hi:.4g} (n = {self.n}, {self.runs} runs)")
         return bool(reasons), reasons
 
-    def summary(self, windows):
+    def summary(self, windows: Mapping[str, Sequence[float]]) -> dict[str, Any]:
         """JSON-ready: bounds, per-window NEES/NIS, ``diverged`` and its reasons, the notes.
 
         Parameters
@@ -358,14 +367,15 @@ class ConsistencyStatistics:
                 "diverged_runs": self.grown_runs + self.nonfinite_runs, "notes": list(self.notes)}
 
 
-def warn_if_diverged(summary, name, stacklevel=2):
+def warn_if_diverged(summary: Mapping[str, Any], name: str, stacklevel: int = 2) -> None:
     """Issue a :class:`FilterDivergenceWarning` when a :meth:`ConsistencyStatistics.summary` says ``diverged``."""
     if summary.get("diverged"):
         warnings.warn(f"filter {name!r} diverged: " + "; ".join(summary["diverged_reasons"]), FilterDivergenceWarning,
                       stacklevel=stacklevel + 1)
 
 
-def consistency(result, xhat0=None, windows=None):
+def consistency(result: SimulationResult, xhat0: ArrayLike | None = None,
+                windows: Mapping[str, Sequence[float]] | None = None) -> tuple[ConsistencyStatistics, dict[str, Any]]:
     """Consistency of a :class:`~hinfnav.sim.SimulationResult` (full histories); warns when it diverged.
 
     Parameters

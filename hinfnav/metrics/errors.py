@@ -7,12 +7,20 @@ state's groups (``"position"``, ``"velocity"`` …, from its
 (:func:`by_group`, :func:`group_rms`), so no metric slices ``[:3]``.
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from .intervals import t_half_width
+
+if TYPE_CHECKING:
+    from ..systems.state import StateSpec
 
 __all__ = [
     "window_mask",
@@ -56,7 +64,7 @@ def _check_error(error, t):
     return error, t
 
 
-def window_mask(t, window):
+def window_mask(t: ArrayLike, window: Sequence[float]) -> NDArray[np.bool_]:
     """Boolean mask of the samples with ``start <= t <= end``.
 
     Raises
@@ -77,7 +85,7 @@ def window_mask(t, window):
     return mask
 
 
-def rms_per_run(error, t, window):
+def rms_per_run(error: ArrayLike, t: ArrayLike, window: Sequence[float]) -> NDArray[np.float64]:
     """RMS of each error component over a time window, per run.
 
     Parameters
@@ -97,21 +105,21 @@ def rms_per_run(error, t, window):
     return np.sqrt(np.mean(error[:, mask] ** 2, axis=1))
 
 
-def rms_error(error, t, window):
+def rms_error(error: ArrayLike, t: ArrayLike, window: Sequence[float]) -> NDArray[np.float64]:
     """RMS of each error component pooled over the runs and a time window, shape (n,)."""
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
     return np.sqrt(np.mean(error[:, mask] ** 2, axis=(0, 1)))
 
 
-def max_error(error, t, window):
+def max_error(error: ArrayLike, t: ArrayLike, window: Sequence[float]) -> NDArray[np.float64]:
     """Largest absolute error per component over runs and window, shape (n,)."""
     error, t = _check_error(error, t)
     mask = window_mask(t, window)
     return np.max(np.abs(error[:, mask]), axis=(0, 1))
 
 
-def convergence_time(error, t, tol):
+def convergence_time(error: ArrayLike, t: ArrayLike, tol: ArrayLike) -> NDArray[np.float64]:
     """Time after which every error component stays within its tolerance.
 
     Parameters
@@ -171,7 +179,7 @@ class MonteCarloSummary:
     pooled: np.ndarray
 
 
-def monte_carlo_summary(error, t, window):
+def monte_carlo_summary(error: ArrayLike, t: ArrayLike, window: Sequence[float]) -> MonteCarloSummary:
     """Summarize Monte Carlo runs by the statistics of their per-run RMS."""
     per_run = rms_per_run(error, t, window)
     runs = per_run.shape[0]
@@ -189,16 +197,16 @@ def monte_carlo_summary(error, t, window):
     )
 
 
-def by_group(values, state):
+def by_group(values: ArrayLike, state: StateSpec) -> dict[str, NDArray[np.float64]]:
     """Split per-component values (last axis = state) into the state's groups: ``{group: values}``."""
     return {g: state.select(values, g) for g in state.groups}
 
 
-def group_rms(values, state, group):
+def group_rms(values: ArrayLike, state: StateSpec, group: str) -> float:
     """One number for a group: ``sqrt(mean(v²))`` over its components (how a table cell is formed)."""
     return axes_rms(state.select(values, group))
 
 
-def axes_rms(values):
+def axes_rms(values: ArrayLike) -> float:
     """One number from per-axis values: ``sqrt(mean(v²))`` over the last axis."""
     return float(np.sqrt(np.mean(np.square(values))))

@@ -13,15 +13,18 @@ for the 2–5 runs of the short sweeps (``t_{0.975, 1} = 12.7``, ``t_{0.975, 4} 
 With one run there is no interval: the half-width is NaN (reported as "n/a").
 """
 
+from __future__ import annotations
+
 import numpy as np
 import scipy.stats
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 
 __all__ = ["t_half_width", "mean_interval", "format_interval"]
 
 
-def t_half_width(values, axis=0, level=0.95):
+def t_half_width(values: ArrayLike, axis: int = 0, level: float = 0.95) -> float | NDArray[np.float64]:
     """Half-width :math:`t_{(1+level)/2,\\,n-1}\\, s/\\sqrt{n}` of the interval of the mean along ``axis``.
 
     Parameters
@@ -52,7 +55,8 @@ def t_half_width(values, axis=0, level=0.95):
     return float(half) if np.ndim(half) == 0 else half
 
 
-def mean_interval(values, axis=0, level=0.95):
+def mean_interval(values: ArrayLike, axis: int = 0,
+                  level: float = 0.95) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64], float | NDArray[np.float64]]:
     """Mean along ``axis`` and its Student-t interval: ``(mean, low, high)`` (NaN bounds for one run)."""
     values = np.asarray(values, dtype=float)
     half = t_half_width(values, axis=axis, level=level)
@@ -61,7 +65,7 @@ def mean_interval(values, axis=0, level=0.95):
     return mean, mean - half, mean + half
 
 
-def format_interval(low, high, fmt=".3g", sep="–"):
+def format_interval(low: float | None, high: float | None, fmt: str = ".3g", sep: str = "–") -> str:
     """``"low–high"``, or ``"n/a (1 run)"`` when the interval is undefined (NaN or None bounds)."""
     if low is None or high is None or not (np.isfinite(low) and np.isfinite(high)):
         return "n/a (1 run)"

@@ -17,15 +17,25 @@ The numbers equal those computed from full histories up to the order of
 floating-point summation (tested).
 """
 
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..sim.montecarlo import simulate_batches
 from .consistency import NIS_KEYS, ConsistencyAccumulator, initial_scale, warn_if_diverged
 from .errors import window_mask
 from .intervals import t_half_width
+
+if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
+    from ..estimators.base import Estimator
+    from ..noise import NoiseModel
 
 __all__ = ["WindowStatistics", "MonteCarloStatistics", "monte_carlo_statistics"]
 
@@ -52,23 +62,23 @@ class WindowStatistics:
     max_abs: np.ndarray
 
     @property
-    def runs(self):
+    def runs(self) -> int:
         return self.per_run.shape[0]
 
     @property
-    def mean(self):
+    def mean(self) -> NDArray[np.float64]:
         """Mean over runs of the per-run RMS, shape (n,)."""
         return self.per_run.mean(axis=0)
 
     @property
-    def ci95(self):
+    def ci95(self) -> NDArray[np.float64]:
         """95 % confidence interval of :attr:`mean` (Student t, :func:`~hinfnav.metrics.intervals.t_half_width`;
         NaN with one run), shape (2, n)."""
         half = t_half_width(self.per_run, axis=0)
         return np.vstack([self.mean - half, self.mean + half])
 
     @property
-    def spread95(self):
+    def spread95(self) -> NDArray[np.float64]:
         """2.5 and 97.5 percentiles of the per-run RMS (what one run may give), shape (2, n)."""
         return np.percentile(self.per_run, [2.5, 97.5], axis=0)
 
@@ -115,8 +125,10 @@ def _convergence(err, t, tol):
     return out
 
 
-def monte_carlo_statistics(scenario, estimator, *, windows, runs=1, seed=0, noise="gaussian", measurement_noise=None,
-                           batch_size=100, progress=False, tol=None, **conditions):
+def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | SynthesisResult, *, windows: Mapping[str, Sequence[float]],
+                           runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, noise: str | NoiseModel = "gaussian",
+                           measurement_noise: str | NoiseModel | None = None, batch_size: int = 100, progress: bool = False,
+                           tol: ArrayLike | None = None, **conditions: Any) -> MonteCarloStatistics:
     """Run Monte Carlo batches and keep running statistics only.
 
     Parameters

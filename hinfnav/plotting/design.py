@@ -11,11 +11,24 @@ components, m/s for the velocity components), so its gains and γ are in
 in the paper's scenario: Nyquist frequency π/T ≈ 31.4 rad/s).
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 from matplotlib.colors import SymLogNorm
+from numpy.typing import ArrayLike
 
-from ..core.exceptions import InputError
 from ..analysis.norms import frequency_grid, frequency_response_sigma
+from ..core.exceptions import InputError
+
+if TYPE_CHECKING:
+    import control
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+
+    from ..design.result import SynthesisResult
 
 __all__ = [
     "GAIN_LABEL",
@@ -29,7 +42,7 @@ __all__ = [
 GAIN_LABEL = "gain of error system Ψ (m or m/s per unit noise)"
 
 
-def plot_gamma_curve(sweep, *, ax, sampled=True, linthresh=0.01):
+def plot_gamma_curve(sweep: Any, *, ax: Axes, sampled: bool = True, linthresh: float = 0.01) -> list[Artist]:
     """γ*(δ̄): certified level against the uncertainty bound.
 
     Parameters
@@ -62,7 +75,8 @@ def plot_gamma_curve(sweep, *, ax, sampled=True, linthresh=0.01):
     return artists
 
 
-def plot_sigma(sys, *, ax, label=None, omega=None, all_values=False, gamma=None, nyquist=True, **line_kw):
+def plot_sigma(sys: control.StateSpace, *, ax: Axes, label: str | None = None, omega: ArrayLike | None = None,
+               all_values: bool = False, gamma: float | None = None, nyquist: bool = True, **line_kw: Any) -> list[Artist]:
     """Singular values of an error system Ψ(e^{jωT}) against frequency.
 
     Parameters
@@ -107,7 +121,8 @@ def plot_sigma(sys, *, ax, label=None, omega=None, all_values=False, gamma=None,
     return artists
 
 
-def plot_worst_case_over_delta(result, *, ax, label=None, **line_kw):
+def plot_worst_case_over_delta(result: SynthesisResult, *, ax: Axes, label: str | None = None,
+                               **line_kw: Any) -> list[Artist]:
     """H∞ norm of the error system at each δ of the certification grid.
 
     Parameters
@@ -135,7 +150,8 @@ def plot_worst_case_over_delta(result, *, ax, label=None, **line_kw):
     return artists
 
 
-def plot_filter_matrices(A_F, B_F, C_F, *, axes, linthresh=1e-4, colorbar=True):
+def plot_filter_matrices(A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, *, axes: Sequence[Axes],
+                         linthresh: float = 1e-4, colorbar: bool = True) -> list[Artist]:
     """Heat maps of the filter matrices (12) on a symmetric-log colour scale.
 
     Parameters

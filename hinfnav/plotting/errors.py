@@ -6,14 +6,28 @@ Error plots read the state's labels, units and groups from the result
 velocity, …), one column per component.
 """
 
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
+
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..sim.montecarlo import SimulationResult
 
 __all__ = ["new_figure", "plot_errors", "plot_error_axis", "plot_inputs", "plot_uncertainty_check"]
 
 
-def new_figure(nrows=1, ncols=1, *, figsize=None, **kwargs):
+def new_figure(nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] | None = None,
+               **kwargs: Any) -> tuple[Figure, Any]:
     """A figure and axes, from :class:`matplotlib.figure.Figure` (no pyplot state)."""
     from matplotlib.figure import Figure
 
@@ -28,7 +42,8 @@ def _run(result, run):
     return result.error[run]
 
 
-def plot_error_axis(t, err, *, ax, label="x", unit="m", band=None, **line_kw):
+def plot_error_axis(t: ArrayLike, err: ArrayLike, *, ax: Axes, label: str = "x", unit: str = "m",
+                    band: float | None = None, **line_kw: Any) -> list[Artist]:
     """One error component against time.
 
     Parameters
@@ -58,7 +73,8 @@ def plot_error_axis(t, err, *, ax, label="x", unit="m", band=None, **line_kw):
     return artists
 
 
-def plot_errors(result, *, axes, run=0, ylims=None, title=None, bands=None):
+def plot_errors(result: SimulationResult, *, axes: Any, run: int = 0, ylims: Mapping[str, Any] | None = None,
+                title: str | None = None, bands: ArrayLike | None = None) -> list[Artist]:
     """Errors of one run, one row per state group and one column per component.
 
     Parameters
@@ -102,7 +118,8 @@ def plot_errors(result, *, axes, run=0, ylims=None, title=None, bands=None):
     return artists
 
 
-def plot_inputs(result, *, ax, run=0, labels=None, unit=""):
+def plot_inputs(result: SimulationResult, *, ax: Axes, run: int = 0, labels: Sequence[str] | None = None,
+                unit: str = "") -> list[Artist]:
     """Input components of one run against time.
 
     Parameters
@@ -132,7 +149,7 @@ def plot_inputs(result, *, ax, run=0, labels=None, unit=""):
     return artists
 
 
-def plot_uncertainty_check(deltas, gaps, norms, *, ax):
+def plot_uncertainty_check(deltas: ArrayLike, gaps: ArrayLike, norms: ArrayLike, *, ax: Axes) -> list[Artist]:
     """Check of the norm-bounded structure (10)–(11) over δ.
 
     Parameters

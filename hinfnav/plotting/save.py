@@ -1,12 +1,21 @@
 """Saving figures with their provenance in the file's metadata."""
 
+from __future__ import annotations
+
 import json
+import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["save_figure"]
 
 
-def save_figure(fig, out_dir, name, provenance=None, *, formats=("png", "pdf"), dpi=130):
+def save_figure(fig: Figure, out_dir: str | os.PathLike[str], name: str, provenance: Mapping[str, Any] | None = None, *,
+                formats: Sequence[str] = ("png", "pdf"), dpi: int = 130) -> list[Path]:
     """Save ``fig`` as ``out_dir/name.<ext>`` for each format; return the paths.
 
     The provenance dict (see :func:`hinfnav.core.provenance.provenance`) goes into

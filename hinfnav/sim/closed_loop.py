@@ -8,21 +8,34 @@ child generator of the seed, drawn exactly as :func:`hinfnav.sim.simulate_truth`
 draws it, so with a controller on the true state both give the same truth.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from ..control.feedback import LinearFeedback
 from ..core.exceptions import InputError
-from ..core.validation import as_int_at_least
 from ..core.progress import bar_disabled
+from ..core.validation import as_int_at_least
 from .montecarlo import SimulationResult, resolve_estimator
 from .truth import child_rngs, draw_noise, noise_models, scenario_truth_model
+
+if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
+    from ..estimators.base import Estimator
+    from ..noise import NoiseModel
+
 
 __all__ = ["simulate_closed_loop"]
 
 
-def simulate_closed_loop(scenario, estimator, controller=None, *, noise="gaussian", measurement_noise=None, runs=1,
-                         seed=0, P0=None, progress=False, **conditions):
+def simulate_closed_loop(scenario: Any, estimator: str | Estimator | SynthesisResult, controller: LinearFeedback | None = None, *,
+                         noise: str | NoiseModel = "gaussian", measurement_noise: str | NoiseModel | None = None, runs: int = 1,
+                         seed: int | np.random.SeedSequence | np.random.Generator = 0, P0: ArrayLike | None = None, progress: bool = False,
+                         **conditions: Any) -> SimulationResult:
     """Simulate the loop plant → measurement → estimator → controller → plant.
 
     Parameters

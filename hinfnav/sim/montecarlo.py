@@ -10,18 +10,29 @@ and, to resolve an estimator given by name, whose estimators are registered
 in :mod:`hinfnav.estimators.registry`. Nothing here defaults to one paper.
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
-from ..core.validation import as_int_at_least
 from ..core.progress import bar_disabled
+from ..core.validation import as_int_at_least
 from ..design.result import SynthesisResult
 from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator
 from .truth import scenario_truth_model, simulate_truth
+
+if TYPE_CHECKING:
+    from ..noise import NoiseModel
+    from ..systems.measurements import MeasurementModel
+    from .truth import Truth
+
 
 __all__ = ["SimulationResult", "available_memory_bytes", "history_bytes", "check_history_memory", "check_measurement_match", "run_estimator", "simulate", "simulate_batches", "resolve_estimator"]
 
@@ -60,19 +71,19 @@ class SimulationResult:
     xhat0: np.ndarray = None
 
     @property
-    def error(self):
+    def error(self) -> NDArray[np.float64]:
         """Estimation error by the state's definition (``x − x̂`` for an additive state)."""
         if self.state is None:
             return self.x - self.xhat
         return self.state.error(self.x, self.xhat)
 
     @property
-    def runs(self):
+    def runs(self) -> int:
         """Number of Monte Carlo runs."""
         return self.x.shape[0]
 
 
-def resolve_estimator(estimator, scenario):
+def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: Any) -> Estimator:
     """An :class:`Estimator`: given, registered under a name for ``scenario``, or built from a design.
 
     A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
@@ -92,7 +103,7 @@ def resolve_estimator(estimator, scenario):
     return estimator
 
 
-def check_measurement_match(estimator, measurement):
+def check_measurement_match(estimator: Estimator, measurement: MeasurementModel | None) -> None:
     """Refuse an estimator whose measurement model is not what the simulation produces.
 
     An estimator built for range, azimuth and elevation must not be fed
@@ -110,7 +121,8 @@ def check_measurement_match(estimator, measurement):
         )
 
 
-def run_estimator(estimator, truth, xhat0, *, P0=None, diagnostics=False):
+def run_estimator(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P0: ArrayLike | None = None,
+                  diagnostics: bool = False) -> SimulationResult:
     """Run an estimator on a simulated truth (all runs at once).
 
     Returns
@@ -145,8 +157,10 @@ def _concat_covariances(Ps, runs):
     return np.concatenate(Ps)
 
 
-def simulate_batches(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
-                     progress=False, diagnostics=False, **conditions):
+def simulate_batches(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+                     measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0,
+                     batch_size: int = 100, progress: bool = False, diagnostics: bool = False,
+                     **conditions: Any) -> Iterator[tuple[int, SimulationResult]]:
     """Yield ``(first_run, SimulationResult)`` batch by batch: histories of ``batch_size`` runs at a time.
 
     Memory is that of one batch, whatever ``runs``; the numbers of run r do not
@@ -169,7 +183,7 @@ def simulate_batches(scenario, estimator, *, noise="gaussian", measurement_noise
             bar.update(n)
 
 
-def available_memory_bytes():
+def available_memory_bytes() -> int | None:
     """Memory available to this process now (``MemAvailable`` of /proc/meminfo), or None where unknown."""
     try:
         with open("/proc/meminfo") as fh:
@@ -181,7 +195,7 @@ def available_memory_bytes():
     return None
 
 
-def history_bytes(scenario, runs, **conditions):
+def history_bytes(scenario: Any, runs: int, **conditions: Any) -> int:
     """Bytes the histories of ``runs`` runs take (x, x̂, u, y, a data-dependent covariance, the innovation and S)."""
     model = scenario_truth_model(scenario, conditions)
     n, m_u, m = model.system.n, model.system.n_input, model.measurement.n_meas
@@ -189,7 +203,7 @@ def history_bytes(scenario, runs, **conditions):
     return int(runs) * (model.n_steps + 1) * per_sample
 
 
-def check_history_memory(scenario, runs, *, fraction=0.8, **conditions):
+def check_history_memory(scenario: Any, runs: int, *, fraction: float = 0.8, **conditions: Any) -> int:
     """Refuse early when the histories of ``runs`` runs would not fit in memory, saying how much they need."""
     runs = as_int_at_least("runs", runs, 1)
     need = history_bytes(scenario, runs, **conditions)
@@ -203,8 +217,9 @@ def check_history_memory(scenario, runs, *, fraction=0.8, **conditions):
     return need
 
 
-def simulate(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
-             progress=False, **conditions):
+def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+             measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, batch_size: int = 100,
+             progress: bool = False, **conditions: Any) -> SimulationResult:
     """Simulate a scenario's truth and run an estimator on it, over Monte Carlo runs.
 
     Parameters

@@ -16,7 +16,12 @@ w first then v, whole histories at once; the same seed gives the same
 numbers whatever the batch size. All runs are stepped together.
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
@@ -32,10 +37,15 @@ from .truth import (
     scenario_truth_model,
 )
 
+if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
+    from ..noise import NoiseModel
+
 __all__ = ["run_on_truth", "simulate_nonlinear", "simulate_nonlinear_truth"]
 
 
-def simulate_nonlinear_truth(model, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, first_run=0):
+def simulate_nonlinear_truth(model: TruthModel, *, noise: str | NoiseModel = "gaussian", measurement_noise: str | NoiseModel | None = None,
+                             runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, first_run: int = 0) -> Truth:
     """Simulate a nonlinear :class:`TruthModel` (its system has ``step``); returns a :class:`Truth`.
 
     Parameters
@@ -77,7 +87,8 @@ def simulate_nonlinear_truth(model, *, noise="gaussian", measurement_noise=None,
     return Truth(t=t, x=x, u=u, y=y, settings=settings, state=system.state, measurement=meas)
 
 
-def run_on_truth(estimator, truth, xhat0, *, P0=None, keep_covariance=False, diagnostics=False):
+def run_on_truth(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P0: ArrayLike | None = None,
+                 keep_covariance: bool | str = False, diagnostics: bool = False) -> SimulationResult:
     """Run an estimator on a simulated truth (all runs at once), keeping only what is asked for.
 
     As :func:`hinfnav.sim.run_estimator`, but the covariance history is not
@@ -99,8 +110,10 @@ def run_on_truth(estimator, truth, xhat0, *, P0=None, keep_covariance=False, dia
                             state=truth.state, diagnostics=hist.diagnostics, xhat0=np.asarray(xhat0, dtype=float))
 
 
-def simulate_nonlinear(scenario, estimator, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, batch_size=100,
-                       progress=False, keep_covariance=False, diagnostics=False, **conditions):
+def simulate_nonlinear(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+                       measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0,
+                       batch_size: int = 100, progress: bool = False, keep_covariance: bool | str = False,
+                       diagnostics: bool = False, **conditions: Any) -> SimulationResult:
     """Monte Carlo runs of an estimator on a scenario with a nonlinear truth (as :func:`hinfnav.sim.simulate`).
 
     Parameters

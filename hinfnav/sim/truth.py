@@ -15,14 +15,23 @@ histories at once. The same seed gives the same numbers, whatever the batch
 size.
 """
 
+from __future__ import annotations
+
 import inspect
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_vector
 from ..noise import ColoredNoise, make_noise
+
+if TYPE_CHECKING:
+    from ..noise import NoiseModel
+
 
 __all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
 
@@ -65,7 +74,7 @@ class TruthModel:
             raise InputError(f"the measurement acts on {self.measurement.n_state} states, the system has {self.system.n}")
 
     @property
-    def time(self):
+    def time(self) -> NDArray[np.float64]:
         """Sample times ``t_k = k dt``, s."""
         return np.arange(self.n_steps + 1) * self.system.dt
 
@@ -99,7 +108,7 @@ class Truth:
     measurement: object = None
 
 
-def scenario_truth_model(scenario, conditions):
+def scenario_truth_model(scenario: Any, conditions: dict[str, Any]) -> TruthModel:
     """``scenario.truth_model(**conditions)``, after checking that ``scenario`` is one and knows every condition.
 
     Raises :class:`InputError` naming an unknown condition (e.g. a misspelt
@@ -122,7 +131,7 @@ def scenario_truth_model(scenario, conditions):
     return build(**conditions)
 
 
-def child_rngs(seed, runs):
+def child_rngs(seed: int | np.random.SeedSequence | np.random.Generator, runs: int) -> list[np.random.Generator]:
     """``runs`` independent generators from ``seed`` (an int ≥ 0, a SeedSequence or a Generator)."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer, np.random.SeedSequence, np.random.Generator)):
         raise InputError(f"seed must be a non-negative integer or a numpy.random.Generator; got {seed!r}")
@@ -142,7 +151,8 @@ def _noise_at(noise, dt, name):
     return model
 
 
-def noise_models(noise, measurement_noise=None, dt=None):
+def noise_models(noise: str | NoiseModel, measurement_noise: str | NoiseModel | None = None,
+                 dt: float | None = None) -> tuple[NoiseModel, NoiseModel]:
     """The process- and measurement-noise models (the second defaults to the first).
 
     With ``dt`` (the system's sampling time, s), colored noise given by name is
@@ -153,7 +163,8 @@ def noise_models(noise, measurement_noise=None, dt=None):
     return w_model, v_model
 
 
-def draw_noise(w_model, v_model, rngs, n_samples, p, q):
+def draw_noise(w_model: NoiseModel, v_model: NoiseModel, rngs: Sequence[np.random.Generator], n_samples: int,
+               p: int, q: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """w (runs, n_samples, p) and v (runs, n_samples, q), each run from its own generator, w first."""
     runs = len(rngs)
     w = np.empty((runs, n_samples, p))
@@ -164,7 +175,8 @@ def draw_noise(w_model, v_model, rngs, n_samples, p, q):
     return w, v
 
 
-def simulate_truth(model, *, noise="gaussian", measurement_noise=None, runs=1, seed=0, first_run=0):
+def simulate_truth(model: TruthModel, *, noise: str | NoiseModel = "gaussian", measurement_noise: str | NoiseModel | None = None,
+                   runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, first_run: int = 0) -> Truth:
     """Simulate the true motion and the measurements of a :class:`TruthModel`.
 
     Parameters

@@ -28,7 +28,12 @@ Three ways to bring a model:
   as :class:`ConstantTurn`.
 """
 
+from __future__ import annotations
+
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
@@ -134,7 +139,7 @@ class DynamicsModel:
 
     linear = False
 
-    def __init__(self, state, dt, Q, *, n_input=0, name="dynamics"):
+    def __init__(self, state: StateSpec, dt: float, Q: ArrayLike, *, n_input: int = 0, name: str = "dynamics") -> None:
         if not isinstance(state, StateSpec):
             raise InputError(f"state must be a StateSpec; got {type(state).__name__}")
         self.state = state
@@ -144,11 +149,11 @@ class DynamicsModel:
         self.name = str(name)
 
     @property
-    def n(self):
+    def n(self) -> int:
         """State dimension."""
         return self.state.n
 
-    def check(self, x, u=None, t=0.0):
+    def check(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, float]:
         """Validated ``(x, u, t)``: x (runs, n) finite, u (runs, n_input) or None, t finite."""
         x = np.asarray(x, dtype=float)
         if x.ndim != 2 or x.shape[1] != self.n:
@@ -166,16 +171,16 @@ class DynamicsModel:
             raise InputError(f"t must be a finite time in s; got {t}")
         return x, u, t
 
-    def f(self, x, u=None, t=0.0):
+    def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """The state one step later, shape (runs, n)."""
         raise NotImplementedError
 
-    def jacobian(self, x, u=None, t=0.0):
+    def jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """``∂f/∂x`` at a batch of states, shape (runs, n, n): central differences by default."""
         x, u, t = self.check(x, u, t)
         return finite_difference_jacobian(self.f, x, u, t)
 
-    def propagate(self, x, u=None, w=None, t=0.0):
+    def propagate(self, x: ArrayLike, u: ArrayLike | None = None, w: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """One step of the truth: ``f(x, u, t) + w`` (w (runs, n) a draw of the process noise, or None)."""
         out = self.f(x, u, t)
         return out if w is None else out + np.asarray(w, dtype=float)
@@ -197,7 +202,9 @@ class DiscreteDynamics(DynamicsModel):
         ``jacobian(x, u, t)`` → (runs, n, n); default central differences.
     """
 
-    def __init__(self, fun, state, dt, Q, *, jacobian=None, n_input=0, name="discrete dynamics"):
+    def __init__(self, fun: Callable[..., ArrayLike], state: StateSpec, dt: float, Q: ArrayLike, *,
+                 jacobian: Callable[..., ArrayLike] | None = None, n_input: int = 0,
+                 name: str = "discrete dynamics") -> None:
         super().__init__(state, dt, Q, n_input=n_input, name=name)
         if not callable(fun):
             raise InputError(f"fun must be callable as fun(x, u, t); got {type(fun).__name__}")
@@ -205,11 +212,11 @@ class DiscreteDynamics(DynamicsModel):
             raise InputError(f"jacobian must be callable as jacobian(x, u, t); got {type(jacobian).__name__}")
         self._fun, self._jac = fun, jacobian
 
-    def f(self, x, u=None, t=0.0):
+    def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         x, u, t = self.check(x, u, t)
         return np.asarray(self._fun(x, u, t), dtype=float)
 
-    def jacobian(self, x, u=None, t=0.0):
+    def jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         if self._jac is None:
             return super().jacobian(x, u, t)
         x, u, t = self.check(x, u, t)
@@ -238,8 +245,9 @@ class ContinuousDynamics(DynamicsModel):
     discrete map that propagates its mean.
     """
 
-    def __init__(self, derivative, state, dt, Q, *, derivative_jacobian=None, substeps=1, n_input=0,
-                 name="continuous dynamics"):
+    def __init__(self, derivative: Callable[..., ArrayLike], state: StateSpec, dt: float, Q: ArrayLike, *,
+                 derivative_jacobian: Callable[..., ArrayLike] | None = None, substeps: int = 1, n_input: int = 0,
+                 name: str = "continuous dynamics") -> None:
         super().__init__(state, dt, Q, n_input=n_input, name=name)
         if not callable(derivative):
             raise InputError(f"derivative must be callable as a(x, u, t); got {type(derivative).__name__}")
@@ -249,11 +257,11 @@ class ContinuousDynamics(DynamicsModel):
         self._a, self._A = derivative, derivative_jacobian
         self.substeps = as_int_at_least("substeps", substeps, 1)
 
-    def derivative(self, x, u=None, t=0.0):
+    def derivative(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """ẋ = a(x, u, t), shape (runs, n)."""
         return np.asarray(self._a(x, u, t), dtype=float)
 
-    def derivative_jacobian(self, x, u=None, t=0.0):
+    def derivative_jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """∂a/∂x, shape (runs, n, n) (analytic if given, else central differences)."""
         if self._A is None:
             return finite_difference_jacobian(self.derivative, x, u, t)
@@ -268,16 +276,16 @@ class ContinuousDynamics(DynamicsModel):
                 J = Ji @ J
         return x, J
 
-    def f(self, x, u=None, t=0.0):
+    def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         x, u, t = self.check(x, u, t)
         return self._integrate(x, u, t, False)[0]
 
-    def jacobian(self, x, u=None, t=0.0):
+    def jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         x, u, t = self.check(x, u, t)
         return self._integrate(x, u, t, True)[1]
 
 
-def constant_turn_state_spec():
+def constant_turn_state_spec() -> StateSpec:
     """Planar position, velocity and turn rate: ``(x, y, vx, vy, ω)`` in m, m/s, rad/s."""
     return StateSpec(
         labels=("x", "y", "vx", "vy", "omega"),
@@ -340,7 +348,7 @@ class ConstantTurn(DynamicsModel):
     name : str
     """
 
-    def __init__(self, dt, sigma_accel, sigma_turn_rate, *, name="constant turn"):
+    def __init__(self, dt: float, sigma_accel: float, sigma_turn_rate: float, *, name: str = "constant turn") -> None:
         dt = as_positive("dt", dt)
         self.sigma_accel = as_nonnegative("sigma_accel", sigma_accel)
         self.sigma_turn_rate = as_nonnegative("sigma_turn_rate", sigma_turn_rate)
@@ -350,7 +358,7 @@ class ConstantTurn(DynamicsModel):
         Q[4, 4] = self.sigma_turn_rate**2
         super().__init__(constant_turn_state_spec(), dt, Q, n_input=0, name=name)
 
-    def f(self, x, u=None, t=0.0):
+    def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """(CT1) for a batch, shape (runs, 5); u is ignored (the model has no input)."""
         x, _, _ = self.check(x, None, t)
         px, py, vx, vy, w = x.T
@@ -358,7 +366,7 @@ class ConstantTurn(DynamicsModel):
         cw, sw = np.cos(w * self.dt), np.sin(w * self.dt)
         return np.stack([px + s * vx - c * vy, py + c * vx + s * vy, cw * vx - sw * vy, sw * vx + cw * vy, w], axis=-1)
 
-    def jacobian(self, x, u=None, t=0.0):
+    def jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """Analytic ``∂f/∂x`` of (CT1), shape (runs, 5, 5)."""
         x, _, _ = self.check(x, None, t)
         _, _, vx, vy, w = x.T

@@ -20,6 +20,9 @@ Format (nested lists of numbers; ``x⁺ = A x + B w``, ``y = C x + D v``,
 Every error names the key in the file.
 """
 
+from __future__ import annotations
+
+import os
 import tomllib
 
 from ..core.exceptions import InputError
@@ -41,7 +44,7 @@ def _matrix(where, table, key, required=True):
         raise InputError(f"{where}.{key}: {exc}") from None
 
 
-def read_system_file(path):
+def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | PolytopicSystem:
     """Read a system TOML file.
 
     Returns

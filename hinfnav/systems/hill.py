@@ -19,9 +19,12 @@ Norm-bounded structure (10)–(11) of Section 4: ``ΔA₁ = H_a F(δ) E_a`` with
 ``F(δ)ᵀF(δ) ≤ I`` for ``|δ| ≤ δ̄``.
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import discretize
@@ -40,7 +43,7 @@ __all__ = [
     "position_measurement",
 ]
 
-def hill_matrices(omega, mass):
+def hill_matrices(omega: float, mass: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Continuous Hill model (2).
 
     Parameters
@@ -71,7 +74,7 @@ def hill_matrices(omega, mass):
     return A0, G0
 
 
-def delta_A1(omega0, delta):
+def delta_A1(omega0: float, delta: float) -> NDArray[np.float64]:
     """The uncertain part ``ΔA₁(δ) = A₀(ω₀(1+δ)) − A₀(ω₀)`` of (5).
 
     Returns
@@ -88,7 +91,7 @@ def delta_A1(omega0, delta):
     return dA
 
 
-def uncertainty_structure(omega0, delta_bar):
+def uncertainty_structure(omega0: float, delta_bar: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The matrices ``H_a`` and ``E_a`` of Section 4, as printed (6x6).
 
     Parameters
@@ -125,7 +128,7 @@ def uncertainty_structure(omega0, delta_bar):
     return H, E
 
 
-def uncertainty_F(delta, delta_bar):
+def uncertainty_F(delta: float, delta_bar: float) -> NDArray[np.float64]:
     """The uncertain matrix ``F_Δa(δ)`` of Section 4 (6x6, diagonal).
 
     Raises
@@ -141,14 +144,15 @@ def uncertainty_F(delta, delta_bar):
     return np.diag([quad, 0.0, quad, delta / delta_bar, delta / delta_bar, 0.0])
 
 
-def measurement_matrix():
+def measurement_matrix() -> NDArray[np.float64]:
     """The indirect position measurement ``C = [I₃ 0]`` of (8), shape (3, 6)."""
     return np.hstack([np.eye(3), np.zeros((3, 3))])
 
 
 
 
-def hill_system(omega, mass, dt, B, *, K=None, discretization="exact", name="Hill relative motion"):
+def hill_system(omega: float, mass: float, dt: float, B: ArrayLike, *, K: ArrayLike | None = None, discretization: str = "exact",
+                name: str = "Hill relative motion") -> LinearSystem:
     """The Hill model (1)–(2) discretized with a zero-order hold, as a :class:`LinearSystem`.
 
     Parameters
@@ -181,6 +185,6 @@ def hill_system(omega, mass, dt, B, *, K=None, discretization="exact", name="Hil
     return LinearSystem(Phi, Gamma, B, dt, chaser_state_spec(), ("Fx", "Fy", "Fz"), ("N", "N", "N"), name=name, info=info)
 
 
-def position_measurement(D):
+def position_measurement(D: ArrayLike) -> LinearMeasurement:
     """The indirect position measurement (8), ``y = [I 0] x + D v``, as a :class:`LinearMeasurement`."""
     return LinearMeasurement(measurement_matrix(), D, ("x", "y", "z"), ("m", "m", "m"))

@@ -5,9 +5,12 @@ dimensions, labels and sampling time from. Unit-variance white noise w
 enters through B, so the process-noise covariance per step is ``Q = B Bᵀ``.
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix, as_positive
@@ -74,41 +77,41 @@ class LinearSystem:
         object.__setattr__(self, "input_units", units)
 
     @property
-    def n(self):
+    def n(self) -> int:
         """State dimension."""
         return self.Phi.shape[0]
 
     @property
-    def n_input(self):
+    def n_input(self) -> int:
         """Number of input channels."""
         return self.Gamma.shape[1]
 
     @property
-    def n_noise(self):
+    def n_noise(self) -> int:
         """Number of process-noise channels (columns of B)."""
         return self.B.shape[1]
 
     @property
-    def Q(self):
+    def Q(self) -> NDArray[np.float64]:
         """Process-noise covariance per step, ``B Bᵀ``."""
         return self.B @ self.B.T
 
-    def transition_matrix(self, K=None):
+    def transition_matrix(self, K: ArrayLike | None = None) -> NDArray[np.float64]:
         """``Φ`` or, with a state-feedback gain K (u = K x), the closed loop ``Φ + Γ K``."""
         if K is None:
             return self.Phi
         K = as_matrix("K", K, (self.n_input, self.n))
         return self.Phi + self.Gamma @ K
 
-    def f(self, x, u=None, t=0.0):
+    def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """The dynamics-model protocol: ``x Φᵀ (+ u Γᵀ)`` for a batch (rows are runs); t is not used."""
         return self.propagate(x, u)
 
-    def jacobian(self, x=None, u=None, t=0.0):
+    def jacobian(self, x: ArrayLike | None = None, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """The dynamics-model protocol: ``∂f/∂x = Φ``, shape (n, n), whatever x."""
         return self.Phi
 
-    def propagate(self, x, u=None, w=None):
+    def propagate(self, x: ArrayLike, u: ArrayLike | None = None, w: ArrayLike | None = None) -> NDArray[np.float64]:
         """One step for a batch: ``x Φᵀ + u Γᵀ + w Bᵀ`` (rows are runs)."""
         out = np.asarray(x) @ self.Phi.T
         if u is not None:

@@ -16,7 +16,12 @@ residual. Models act on batches: ``x`` of shape (..., n).
   [lower, upper], reporting which channels saturated.
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_positive
@@ -52,7 +57,7 @@ class MeasurementModel:
     linear = False
     H = None
 
-    def __init__(self, n_state, D, labels, units):
+    def __init__(self, n_state: int, D: ArrayLike, labels: Sequence[str], units: Sequence[str]) -> None:
         self.n_state = int(n_state)
         self.D = as_matrix("D", D)
         self.D.setflags(write=False)
@@ -62,37 +67,37 @@ class MeasurementModel:
             raise InputError(f"labels and units must have {self.D.shape[0]} entries (rows of D)")
 
     @property
-    def n_meas(self):
+    def n_meas(self) -> int:
         """Number of measurement channels."""
         return self.D.shape[0]
 
     @property
-    def n_noise(self):
+    def n_noise(self) -> int:
         """Number of noise channels (columns of D)."""
         return self.D.shape[1]
 
     @property
-    def R(self):
+    def R(self) -> NDArray[np.float64]:
         """Noise covariance ``D Dᵀ``."""
         return self.D @ self.D.T
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         """``h(x)`` for a batch ``x`` of shape (..., n), shape (..., m)."""
         raise NotImplementedError
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         """``∂h/∂x`` at a batch of states, shape (..., m, n)."""
         raise NotImplementedError
 
-    def residual(self, y, yhat):
+    def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         """``y − ŷ`` (angles wrapped where a model has them)."""
         return np.asarray(y) - np.asarray(yhat)
 
-    def measure(self, x, v):
+    def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Noisy measurements ``h(x) + v Dᵀ`` of a batch; ``v`` of shape (..., q)."""
         return self.function(x) + np.asarray(v) @ self.D.T
 
-    def check_state(self, x, name="x"):
+    def check_state(self, x: ArrayLike, name: str = "x") -> NDArray[np.float64]:
         x = np.asarray(x, dtype=float)
         if x.ndim < 1 or x.shape[-1] != self.n_state:
             raise InputError(f"{name} must have shape (..., {self.n_state}); got {x.shape}")
@@ -111,7 +116,8 @@ class LinearMeasurement(MeasurementModel):
 
     linear = True
 
-    def __init__(self, C, D, labels=None, units=None):
+    def __init__(self, C: ArrayLike, D: ArrayLike, labels: Sequence[str] | None = None,
+                 units: Sequence[str] | None = None) -> None:
         C = as_matrix("C", C)
         m = C.shape[0]
         D = as_matrix("D", D, (m, None))
@@ -120,18 +126,18 @@ class LinearMeasurement(MeasurementModel):
         self.H = C
 
     @property
-    def C(self):
+    def C(self) -> NDArray[np.float64]:
         """The measurement matrix."""
         return self.H
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         return np.asarray(x) @ self.H.T
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         x = np.asarray(x)
         return np.broadcast_to(self.H, x.shape[:-1] + self.H.shape)
 
-    def measure(self, x, v):
+    def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         return np.asarray(x) @ self.H.T + np.asarray(v) @ self.D.T
 
 
@@ -158,14 +164,14 @@ def _positions(x):
     return x[..., :3]
 
 
-def wrap_angle(angle):
+def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
     """Wrap angles to (−π, π] (angles already inside are returned unchanged)."""
     angle = np.asarray(angle, dtype=float)
     inside = (angle > -np.pi) & (angle <= np.pi)
     return np.where(inside, angle, np.pi - np.mod(np.pi - angle, 2 * np.pi))
 
 
-def range_angles(x, C_bl=None):
+def range_angles(x: ArrayLike, C_bl: ArrayLike | None = None) -> NDArray[np.float64]:
     """Range, azimuth and elevation of a relative position, inverse of (7).
 
     (7) reads ``(x, y, z)ᵀ = C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)ᵀ``,
@@ -192,7 +198,7 @@ def range_angles(x, C_bl=None):
     return np.stack([rho, np.arctan2(p[..., 1], p[..., 0]), np.arctan2(-p[..., 2], h)], axis=-1)
 
 
-def range_angles_jacobian(x, C_bl=None, n_state=None):
+def range_angles_jacobian(x: ArrayLike, C_bl: ArrayLike | None = None, n_state: int | None = None) -> NDArray[np.float64]:
     """Jacobian of :func:`range_angles` with respect to the state, batched.
 
     Parameters
@@ -235,7 +241,7 @@ def range_angles_jacobian(x, C_bl=None, n_state=None):
     return J
 
 
-def position_from_range_angles(m, C_bl=None):
+def position_from_range_angles(m: ArrayLike, C_bl: ArrayLike | None = None) -> NDArray[np.float64]:
     """Relative position from range and line-of-sight angles, eq. (7).
 
     Parameters
@@ -276,7 +282,7 @@ class RangeAzimuthElevation(MeasurementModel):
         Rotation from the relative frame to the sensor frame (identity).
     """
 
-    def __init__(self, n_state, sigma_range, sigma_angle, C_bl=None):
+    def __init__(self, n_state: int, sigma_range: float, sigma_angle: float, C_bl: ArrayLike | None = None) -> None:
         n_state = as_int_at_least("n_state", n_state, 3)  # the first three components are the position
         self.sigma_range = as_positive("sigma_range", sigma_range)
         self.sigma_angle = as_positive("sigma_angle", sigma_angle)
@@ -286,28 +292,28 @@ class RangeAzimuthElevation(MeasurementModel):
             ("range", "azimuth", "elevation"), ("m", "rad", "rad"),
         )
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         return range_angles(self.check_state(x), self.C_bl)
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         return range_angles_jacobian(self.check_state(x), self.C_bl, self.n_state)
 
-    def residual(self, y, yhat):
+    def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(y, dtype=float) - np.asarray(yhat, dtype=float)
         d = d.copy()
         d[..., 1:] = wrap_angle(d[..., 1:])
         return d
 
-    def measure(self, x, v):
+    def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         out = self.function(x) + np.asarray(v) @ self.D.T
         out[..., 1] = wrap_angle(out[..., 1])
         return out
 
-    def inverse(self, m):
+    def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """The indirect position measurement: position (m) from (ρ, α, β), eq. (7)."""
         return position_from_range_angles(m, self.C_bl)
 
-    def position_covariance(self, m):
+    def position_covariance(self, m: ArrayLike) -> NDArray[np.float64]:
         """Covariance ``J R Jᵀ`` of the converted position at (ρ, α, β) (first order), shape (..., 3, 3)."""
         m = np.asarray(m, dtype=float)
         rho, a, b = m[..., 0], m[..., 1], m[..., 2]
@@ -333,7 +339,7 @@ class Saturated(MeasurementModel):
         Channel bounds (``-inf``/``inf`` for a channel that does not saturate).
     """
 
-    def __init__(self, model, lower, upper):
+    def __init__(self, model: MeasurementModel, lower: ArrayLike, upper: ArrayLike) -> None:
         if not isinstance(model, MeasurementModel):
             raise InputError(f"model must be a MeasurementModel; got {type(model).__name__}")
         m = model.n_meas
@@ -350,25 +356,25 @@ class Saturated(MeasurementModel):
         self.linear = model.linear
         self.H = model.H
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         return self.model.function(x)
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         return self.model.jacobian(x)
 
-    def residual(self, y, yhat):
+    def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         return self.model.residual(y, yhat)
 
-    def clip(self, y):
+    def clip(self, y: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
         """``(clipped y, flags)``: flags True where a channel sat at a bound."""
         y = np.asarray(y, dtype=float)
         return np.clip(y, self.lower, self.upper), (y <= self.lower) | (y >= self.upper)
 
-    def measure(self, x, v):
+    def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         return self.clip(self.model.measure(x, v))[0]
 
 
-def as_measurement_model(value, name="measurement"):
+def as_measurement_model(value: object, name: str = "measurement") -> MeasurementModel:
     """Check that ``value`` is a :class:`MeasurementModel`."""
     if not isinstance(value, MeasurementModel):
         raise InputError(f"{name} must be a hinfnav MeasurementModel; got {type(value).__name__}")
@@ -415,7 +421,7 @@ class ConvertedPosition(MeasurementModel):
 
     linear = True
 
-    def __init__(self, sensor):
+    def __init__(self, sensor: MeasurementModel) -> None:
         if not isinstance(sensor, RangeAzimuthElevation):
             raise InputError(f"sensor must be a RangeAzimuthElevation model; got {type(sensor).__name__}")
         super().__init__(sensor.n_state, sensor.D, sensor.labels, sensor.units)
@@ -426,32 +432,32 @@ class ConvertedPosition(MeasurementModel):
         self.H = H
 
     @property
-    def R(self):
+    def R(self) -> NDArray[np.float64]:
         """Not defined: the converted position's covariance depends on the reading (see :meth:`noise_covariance`)."""
         raise InputError("a converted measurement has no constant R: its covariance J R Jᵀ depends on the reading "
                          "(use noise_covariance(y), or give the filter an explicit R)")
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         """The position ``[I 0] x``, shape (..., 3), m."""
         return self.check_state(x) @ self.H.T
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         """``[I 0]`` broadcast over the batch, shape (..., 3, n)."""
         x = self.check_state(x)
         return np.broadcast_to(self.H, x.shape[:-1] + self.H.shape)
 
-    def convert(self, y):
+    def convert(self, y: ArrayLike) -> NDArray[np.float64]:
         """The indirect position measurement ``g(y)`` of readings (ρ, α, β), shape (..., 3), m."""
         return self.sensor.inverse(y)
 
-    def residual(self, y, yhat):
+    def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         """``g(y) − ŷ``: the converted reading minus a predicted position, m."""
         return self.convert(y) - np.asarray(yhat, dtype=float)
 
-    def measure(self, x, v):
+    def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """The sensor's noisy readings (ρ, α, β) of a batch (see :meth:`RangeAzimuthElevation.measure`)."""
         return self.sensor.measure(x, v)
 
-    def noise_covariance(self, y):
+    def noise_covariance(self, y: ArrayLike) -> NDArray[np.float64]:
         """``R_k = J(y) R J(y)ᵀ`` of the converted position at readings ``y``, shape (..., 3, 3), m²."""
         return self.sensor.position_covariance(y)

@@ -12,7 +12,10 @@ The planar counterpart of :class:`~hinfnav.systems.measurements.RangeAzimuthElev
 for a tracking problem brought by a user (notebook 80).
 """
 
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive, as_vector
@@ -44,7 +47,8 @@ class RangeBearing(MeasurementModel):
         Indices of the planar position in the state (default (0, 1)).
     """
 
-    def __init__(self, n_state, sigma_range, sigma_bearing, origin=(0.0, 0.0), position=(0, 1)):
+    def __init__(self, n_state: int, sigma_range: float, sigma_bearing: float,
+                 origin: tuple[float, float] = (0.0, 0.0), position: tuple[int, int] = (0, 1)) -> None:
         n_state = as_int_at_least("n_state", n_state, 2)
         self.sigma_range = as_positive("sigma_range", sigma_range)
         self.sigma_bearing = as_positive("sigma_bearing", sigma_bearing)
@@ -64,12 +68,12 @@ class RangeBearing(MeasurementModel):
             raise InputError("x must contain only finite numbers; it has NaN or inf entries")
         return x[..., list(self.position)] - self.origin
 
-    def function(self, x):
+    def function(self, x: ArrayLike) -> NDArray[np.float64]:
         """(P1) for a batch (..., n): shape (..., 2), (m, rad)."""
         d = self._offset(x)
         return np.stack([np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])], axis=-1)
 
-    def jacobian(self, x):
+    def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
         """(P2), shape (..., 2, n); an :class:`InputError` at zero range (bearing undefined)."""
         d = self._offset(x)
         r2 = d[..., 0] ** 2 + d[..., 1] ** 2
@@ -87,7 +91,7 @@ class RangeBearing(MeasurementModel):
     residual = RangeAzimuthElevation.residual
     measure = RangeAzimuthElevation.measure
 
-    def inverse(self, m):
+    def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """(P3) The position ``o + r (cos b, sin b)`` of readings (r, b), shape (..., 2), m."""
         m = np.asarray(m, dtype=float)
         if m.ndim < 1 or m.shape[-1] != 2:
@@ -96,7 +100,7 @@ class RangeBearing(MeasurementModel):
             raise InputError("m must contain only finite numbers; it has NaN or inf entries")
         return self.origin + m[..., :1] * np.stack([np.cos(m[..., 1]), np.sin(m[..., 1])], axis=-1)
 
-    def position_covariance(self, m):
+    def position_covariance(self, m: ArrayLike) -> NDArray[np.float64]:
         """(P4) ``J R Jᵀ``, ``J = [[cos b, −r sin b], [sin b, r cos b]]`` at readings (r, b), shape (..., 2, 2), m²."""
         m = np.asarray(m, dtype=float)
         r, b = m[..., 0], m[..., 1]
@@ -119,7 +123,7 @@ class ConvertedRangeBearing(ConvertedPosition):
     sensor : RangeBearing
     """
 
-    def __init__(self, sensor):
+    def __init__(self, sensor: RangeBearing) -> None:
         if not isinstance(sensor, RangeBearing):
             raise InputError(f"sensor must be a RangeBearing model; got {type(sensor).__name__}")
         MeasurementModel.__init__(self, sensor.n_state, sensor.D, sensor.labels, sensor.units)

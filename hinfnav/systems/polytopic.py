@@ -9,11 +9,15 @@ writes a norm-bounded ``A + H F E`` with a diagonal (or scalar) F as the
 polytope of its sign vertices; :func:`two_mass_spring` is an example plant.
 """
 
+from __future__ import annotations
+
 import itertools
-from math import comb
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from math import comb
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix, as_positive
@@ -62,7 +66,8 @@ class PolytopicSystem:
         object.__setattr__(self, "dt", as_positive("dt", self.dt))
 
     @classmethod
-    def from_matrices(cls, nominal, vertices, dt=1.0, labels=()):
+    def from_matrices(cls, nominal: Mapping[str, ArrayLike], vertices: Sequence[Mapping[str, ArrayLike]],
+                      dt: float = 1.0, labels: Sequence[str] = ()) -> PolytopicSystem:
         """Vertices given as dicts of the matrices that differ from ``nominal`` (a dict of A, B, C, D, L)."""
         if not isinstance(nominal, dict) or any(k not in nominal for k in MATRIX_KEYS):
             raise InputError(f"nominal must be a dict with the matrices {', '.join(MATRIX_KEYS)}")
@@ -78,7 +83,8 @@ class PolytopicSystem:
         return cls(tuple(out), dt, labels)
 
     @classmethod
-    def from_norm_bounded(cls, system, groups=None):
+    def from_norm_bounded(cls, system: UncertainSystem,
+                          groups: str | Sequence[Sequence[int]] | None = None) -> PolytopicSystem:
         """The polytope of ``A + H F E`` for a diagonal F with entries in [−1, 1] (sign vertices).
 
         Parameters
@@ -129,20 +135,20 @@ class PolytopicSystem:
         return cls(tuple(verts), system.dt, tuple(labels))
 
     @property
-    def n_vertices(self):
+    def n_vertices(self) -> int:
         return len(self.vertices)
 
     @property
-    def n(self):
+    def n(self) -> int:
         return self.vertices[0].n
 
-    def varying(self):
+    def varying(self) -> tuple[str, ...]:
         """Names of the matrices that differ between vertices."""
         v0 = self.vertices[0]
         return tuple(k for k in MATRIX_KEYS if any(not np.array_equal(getattr(v, k), getattr(v0, k))
                                                    for v in self.vertices[1:]))
 
-    def norm_bounded_cover(self):
+    def norm_bounded_cover(self) -> UncertainSystem:
         """A norm-bounded ``A₀ + H F E`` (FᵀF ≤ I) containing a two-vertex polytope in which only A varies.
 
         ``A₀`` is the midpoint and ``H F E`` with ``H = U Σ``, ``E = Vᵀ`` (the
@@ -157,7 +163,7 @@ class PolytopicSystem:
         r = max(1, int(np.sum(sv > 1e-12 * max(sv[0], np.finfo(float).tiny))))
         return UncertainSystem((v0.A + v1.A) / 2.0, v0.B, v0.C, v0.D, v0.L, U[:, :r] * sv[:r], Vt[:r], dt=self.dt)
 
-    def at(self, alpha):
+    def at(self, alpha: ArrayLike) -> UncertainSystem:
         """The nominal system at the convex weights ``alpha`` (shape (N,), ≥ 0, summing to 1)."""
         a = np.asarray(alpha, dtype=float)
         if a.shape != (self.n_vertices,) or np.any(a < -1e-12) or abs(a.sum() - 1.0) > 1e-9:
@@ -165,7 +171,7 @@ class PolytopicSystem:
         mats = {k: sum(ai * getattr(v, k) for ai, v in zip(a, self.vertices)) for k in MATRIX_KEYS}
         return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=self.dt)
 
-    def center(self):
+    def center(self) -> UncertainSystem:
         """The system at the barycentre of the vertices."""
         return self.at(np.full(self.n_vertices, 1.0 / self.n_vertices))
 
@@ -174,7 +180,8 @@ def system_nominal(system):
     return UncertainSystem(system.A, system.B, system.C, system.D, system.L, dt=system.dt)
 
 
-def simplex_grid(n_vertices, points=41, n_random=0, seed=0):
+def simplex_grid(n_vertices: int, points: int = 41, n_random: int = 0,
+                 seed: int | np.random.Generator = 0) -> NDArray[np.float64]:
     """Convex weights covering the unit simplex: the vertices, a barycentric lattice, random points.
 
     The lattice has step ``1/k`` with k the largest resolution giving at most
@@ -204,7 +211,8 @@ def simplex_grid(n_vertices, points=41, n_random=0, seed=0):
     return np.unique(np.round(np.array(pts), 15), axis=0)
 
 
-def two_mass_spring(stiffness_range=0.3, *, m1=1.0, m2=1.0, k1=1.0, k2=1.0, c=0.05, dt=0.1):
+def two_mass_spring(stiffness_range: float = 0.3, *, m1: float = 1.0, m2: float = 1.0, k1: float = 1.0,
+                    k2: float = 1.0, c: float = 0.05, dt: float = 0.1) -> PolytopicSystem:
     """Two masses on springs (wall–k1–m1–k2–m2), the coupling stiffness k2 uncertain: a two-vertex polytope.
 
     States ``x = [q1, q2, v1, v2]`` (m, m/s); the coupling stiffness is

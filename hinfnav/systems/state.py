@@ -7,9 +7,13 @@ estimation error (additive here; an attitude state overrides :meth:`error`
 with a multiplicative quaternion error).
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 
@@ -67,31 +71,31 @@ class StateSpec:
         object.__setattr__(self, "axis_names", axis)
 
     @property
-    def n(self):
+    def n(self) -> int:
         """Dimension of the state."""
         return len(self.labels)
 
-    def group_unit(self, group):
+    def group_unit(self, group: str) -> str:
         """Unit of a group's components."""
         return self.units[self.indices(group)[0]]
 
-    def indices(self, group):
+    def indices(self, group: str) -> Sequence[int]:
         """Component indices of a group (an :class:`InputError` names the known groups)."""
         try:
             return self.groups[group]
         except KeyError:
             raise InputError(f"unknown state group {group!r}; this state has {', '.join(self.groups) or 'none'}") from None
 
-    def select(self, values, group):
+    def select(self, values: ArrayLike, group: str) -> NDArray[np.float64]:
         """The components of ``values`` (last axis = state) that belong to ``group``."""
         return np.asarray(values)[..., list(self.indices(group))]
 
-    def error(self, x, xhat):
+    def error(self, x: ArrayLike, xhat: ArrayLike) -> NDArray[np.float64]:
         """Estimation error ``x − x̂`` (additive), same shape as the inputs."""
         return np.asarray(x) - np.asarray(xhat)
 
 
-def chaser_state_spec():
+def chaser_state_spec() -> StateSpec:
     """Relative position and velocity in the target's orbital frame (Hill): 6 components."""
     return StateSpec(
         labels=("x", "y", "z", "vx", "vy", "vz"),

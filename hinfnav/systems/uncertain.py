@@ -4,9 +4,12 @@
 ``z(k) = L x(k)``, with ``FᵀF ≤ I``: what the robust filter designs take.
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix, as_positive
@@ -67,11 +70,11 @@ class UncertainSystem:
         object.__setattr__(self, "dt", as_positive("dt", self.dt))
 
     @property
-    def n(self):
+    def n(self) -> int:
         """State dimension."""
         return self.A.shape[0]
 
-    def perturbed_A(self, F):
+    def perturbed_A(self, F: ArrayLike | None) -> NDArray[np.float64]:
         """``A + H F E`` for a given uncertainty matrix ``F`` (shape (r, r))."""
         if self.H is None:
             return self.A.copy()

@@ -6,9 +6,12 @@ gain, the published filter (A_F, B_F, C_F) designed at δ̄ = 0.05, Table 1,
 the citation, and the documented choices that fill what the paper leaves out.
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...core.validation import as_matrix
 
@@ -118,12 +121,12 @@ class PublishedFilter:
     dt: float = 0.1
 
 
-def published_filter():
+def published_filter() -> PublishedFilter:
     """The published filter matrices A_F, B_F, C_F of Section 4 (copies)."""
     return PublishedFilter(_PAPER_AF.copy(), _PAPER_BF.copy(), _PAPER_CF.copy())
 
 
-def infer_sampling_time(A_F=None, B_F=None):
+def infer_sampling_time(A_F: ArrayLike | None = None, B_F: ArrayLike | None = None) -> tuple[float, float]:
     """Infer the sampling time T from the published filter.
 
     The paper never prints T. With the indirect measurement ``C = [I 0]``

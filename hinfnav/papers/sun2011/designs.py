@@ -7,12 +7,19 @@ this scenario; here the scenario's uncertain model, its diagonal F_Δa and the
 :class:`~hinfnav.design.SampleSet`.
 """
 
+from __future__ import annotations
+
 import dataclasses
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import control
 import numpy as np
 import scipy.optimize
+from numpy.typing import NDArray
 from tqdm import tqdm
 
 from ...analysis.error_system import error_system, worst_case_norm
@@ -20,9 +27,9 @@ from ...analysis.norms import channel_norms, hinf_norm
 from ...analysis.observer import observer_form
 from ...core.exceptions import InputError, UnstablePlantError
 from ...core.linalg import spectral_radius
-from ...core.validation import as_int_at_least, as_nonnegative, check_keywords
 from ...core.progress import bar_disabled
 from ...core.provenance import provenance
+from ...core.validation import as_int_at_least, as_nonnegative, check_keywords
 from ...design import io as design_io
 from ...design.result import SynthesisResult
 from ...design.robust_hinf import synthesize
@@ -32,6 +39,9 @@ from ...lmi.robust_brl import robust_bounded_real_lmi
 from ...systems.hill import uncertainty_F
 from .constants import DEFAULT_DELTA_BARS, published_filter
 from .scenario import Scenario
+
+if TYPE_CHECKING:
+    from ...design.polytopic import PolytopicResult
 
 __all__ = [
     "delta_grid",
@@ -86,7 +96,8 @@ def delta_samples(delta_bar, points=21):
     )
 
 
-def design_for_scenario(scenario=None, delta_bar=None, *, delta_points=21, **options):
+def design_for_scenario(scenario: Scenario | None = None, delta_bar: float | None = None, *, delta_points: int = 21,
+                        **options: Any) -> SynthesisResult:
     """Design the robust filter for a scenario's closed-loop model at δ̄.
 
     Builds ψ_d from ``scenario.design_model(delta_bar)`` (A = I + T(A₁ + G₀K),
@@ -152,32 +163,32 @@ class GammaSweep:
     results: tuple
 
     @property
-    def gammas(self):
+    def gammas(self) -> NDArray[np.float64]:
         """Certified γ per δ̄, shape (k,)."""
         return np.array([r.gamma for r in self.results])
 
     @property
-    def lmi_gammas(self):
+    def lmi_gammas(self) -> NDArray[np.float64]:
         """Solver γ per δ̄, shape (k,)."""
         return np.array([r.lmi_gamma for r in self.results])
 
     @property
-    def verified_norms(self):
+    def verified_norms(self) -> NDArray[np.float64]:
         """Worst sampled norm per δ̄, shape (k,)."""
         return np.array([r.verified_norm for r in self.results])
 
     @property
-    def solve_times(self):
+    def solve_times(self) -> NDArray[np.float64]:
         """Solver wall time per δ̄, s, shape (k,)."""
         return np.array([r.solve_time_s for r in self.results])
 
     @property
-    def nondecreasing(self):
+    def nondecreasing(self) -> bool:
         """Whether the certified γ*(δ̄) is non-decreasing (δ̄ sorted ascending)."""
         order = np.argsort(self.delta_bars)
         return bool(np.all(np.diff(self.gammas[order]) >= 0))
 
-    def table(self):
+    def table(self) -> list[dict[str, Any]]:
         """Rows ``(δ̄, γ, lmi_γ, verified norm, worst δ, solver, method, time)`` as dicts."""
         return [
             {
@@ -194,7 +205,8 @@ class GammaSweep:
         ]
 
 
-def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **options):
+def gamma_sweep(delta_bars: Sequence[float] = DEFAULT_DELTA_BARS, scenario: Scenario | None = None,
+                progress: bool = False, **options: Any) -> GammaSweep:
     """Certified designs for several δ̄ (Corollary 1 at each).
 
     Parameters
@@ -223,7 +235,8 @@ def gamma_sweep(delta_bars=DEFAULT_DELTA_BARS, scenario=None, progress=False, **
     return GammaSweep(dbs, tuple(results))
 
 
-def design_report(delta_bar, solver=None, scenario=None, form="general"):
+def design_report(delta_bar: float, solver: str | None = None, scenario: Scenario | None = None,
+                  form: str = "general") -> dict[str, Any]:
     """JSON-ready summary of one certified design (for ``python -m hinfnav design``).
 
     Parameters
@@ -318,7 +331,8 @@ def format_design_report(report):
     return "\n".join(lines)
 
 
-def compare_with_published(scenario=None, solver=None, delta_points=21, design=None):
+def compare_with_published(scenario: Scenario | None = None, solver: str | None = None, delta_points: int = 21,
+                           design: SynthesisResult | None = None) -> dict[str, Any]:
     """The published filter (δ̄ = 0.05) against the re-synthesized optimum.
 
     Both filters are evaluated on the same error system (13)–(15) of the
@@ -425,7 +439,8 @@ def _is_scenario_design(result):
     return own.A.shape == ref.A.shape and np.allclose(own.A, ref.A) and np.allclose(own.B, ref.B)
 
 
-def save_design(result, path, scenario=None):
+def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLike[str],
+                scenario: Scenario | None = None) -> Path:
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
 
     The file holds the filter, its certificate, the uncertain system ψ_d of
@@ -447,7 +462,7 @@ def save_design(result, path, scenario=None):
     return design_io.save_design(result, system, path, options=options, extra=extra)
 
 
-def load_design(path, scenario=None):
+def load_design(path: str | os.PathLike[str], scenario: Scenario | None = None) -> SynthesisResult:
     """Load a design file and check it was made for ``scenario`` (default the paper's).
 
     Raises

@@ -46,9 +46,13 @@ range/angle model each run carries its own covariance.
 ``ExtendedKalmanFilter`` run by run.
 """
 
+from __future__ import annotations
+
 import inspect
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_nonnegative, as_positive, check_keywords
@@ -72,20 +76,20 @@ DYNAMICS_MODELS = ("unforced", "applied_thrust", "control_law")
 
 
 def EKF(
-    scenario,
+    scenario: Scenario,
     *,
-    measurement="position",
-    dynamics="unforced",
-    discretization="exact",
-    Q=None,
-    R=None,
-    P0=None,
-    sigma_range=None,
-    sigma_angle=None,
-    C_bl=None,
-    output="filtered",
-    name=None,
-):
+    measurement: str = "position",
+    dynamics: str = "unforced",
+    discretization: str = "exact",
+    Q: ArrayLike | None = None,
+    R: ArrayLike | None = None,
+    P0: ArrayLike | None = None,
+    sigma_range: float | None = None,
+    sigma_angle: float | None = None,
+    C_bl: ArrayLike | None = None,
+    output: str = "filtered",
+    name: str | None = None,
+) -> ExtendedKalmanFilter:
     """Extended Kalman filter of the chaser's relative state (filterpy).
 
     Parameters
@@ -193,7 +197,7 @@ def EKF(
                                 output=output, name=name)
 
 
-def build_ekf(scenario, known_input=False, **options):
+def build_ekf(scenario: Scenario, known_input: bool = False, **options: Any) -> ExtendedKalmanFilter:
     """Build the EKF of the filter registry (names ``ekf``, ``ekf_known_input``).
 
     Parameters
@@ -232,7 +236,8 @@ def build_ekf(scenario, known_input=False, **options):
 _EKF_OPTIONS = tuple(p for p in inspect.signature(EKF).parameters if p != "scenario")
 
 
-def range_angle_measurements(x, rng, sigma_range=DEFAULT_SIGMA_RANGE, sigma_angle=DEFAULT_SIGMA_ANGLE, C_bl=None):
+def range_angle_measurements(x: ArrayLike, rng: np.random.Generator, sigma_range: float = DEFAULT_SIGMA_RANGE,
+                             sigma_angle: float = DEFAULT_SIGMA_ANGLE, C_bl: ArrayLike | None = None) -> NDArray[np.float64]:
     """Noisy range/azimuth/elevation measurements of the states ``x``, eq. (7).
 
     Parameters

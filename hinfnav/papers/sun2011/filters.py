@@ -20,6 +20,10 @@ name                       estimator
 =========================  ===============================================
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ...core.exceptions import InputError
@@ -29,6 +33,9 @@ from .constants import published_filter
 from .designs import design_for_scenario
 from .ekf import build_ekf
 from .scenario import Scenario
+
+if TYPE_CHECKING:
+    from ...estimators.base import Estimator
 
 __all__ = ["FILTER_NAMES", "VERBATIM", "make_estimator", "lti_from_matrices"]
 
@@ -71,7 +78,7 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True, design_
     return scenario.lti_filter(A_F, B_F, C_F, name=name, uses_input=uses_input, design_dt=design_dt)
 
 
-def make_estimator(name, scenario, **options):
+def make_estimator(name: str, scenario: Scenario, **options: Any) -> Estimator:
     """Build an estimator by name (see the module table).
 
     Parameters

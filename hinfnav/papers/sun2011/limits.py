@@ -31,9 +31,13 @@ model adds to the velocity at every step (0.001 m/s).
 a fixed LTI filter (12) when the plant is stable (the closed loop).
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ...analysis.riccati import stationary_lti_error_covariance, steady_state_kalman
 from ...core.exceptions import InputError
@@ -77,7 +81,7 @@ class KalmanLimit:
     maneuver: bool
     discretization: str
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict of the per-axis numbers (lists of floats) and settings."""
         return {
             "pos_m": self.pos_m.tolist(),
@@ -89,7 +93,7 @@ class KalmanLimit:
         }
 
 
-def kalman_limit(scenario, maneuver=True, discretization="exact"):
+def kalman_limit(scenario: Scenario, maneuver: bool = True, discretization: str = "exact") -> KalmanLimit:
     """Steady-state Kalman error of the scenario's stated white-noise model.
 
     Parameters
@@ -153,8 +157,9 @@ def kalman_limit(scenario, maneuver=True, discretization="exact"):
 
 
 def lti_error_covariance(
-    A_F, B_F, C_F, scenario, *, maneuver=True, input_matrix=None, K=None, delta=0.0, discretization="exact"
-):
+    A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, scenario: Scenario, *, maneuver: bool = True,
+    input_matrix: ArrayLike | None = None, K: ArrayLike | None = None, delta: float = 0.0, discretization: str = "exact"
+) -> NDArray[np.float64]:
     """Stationary error covariance of the LTI filter (12) on the closed loop.
 
     The truth ``x(k+1) = A_t x(k) + B w(k)``, ``A_t = Φ(δ) + Γ(δ) K`` with

@@ -21,19 +21,25 @@ both certified γ and ν. Before, the knee at δ̄ = 0.05 (γ 0.410, ν 0.140773
 beaten on both by the H2 row (γ 0.393, ν 0.140733).
 """
 
+from __future__ import annotations
+
 import dataclasses
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from tqdm import tqdm
 
+from ...analysis.error_system import error_system_matrices
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_nonnegative, as_positive
-from ...analysis.error_system import error_system_matrices
 from ...design.mixed import front_gammas, knee_index, mixed_front, synthesize_mixed
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
 from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from
 from .scenario import Scenario
+
+if TYPE_CHECKING:
+    from ...design.mixed import MixedSynthesisResult
 
 __all__ = ["mixed_design_for_scenario", "mixed_front_for_scenario", "mixed_design_report",
            "format_mixed_design_report", "analysis_gamma", "certify_front", "certified_knee"]
@@ -56,7 +62,9 @@ def _with_grid(result, delta_bar, delta_points):
                                deltas=np.asarray(delta_grid(delta_bar, delta_points), dtype=float))
 
 
-def mixed_design_for_scenario(scenario=None, delta_bar=None, gamma=None, *, delta_points=21, **options):
+def mixed_design_for_scenario(scenario: Scenario | None = None, delta_bar: float | None = None,
+                              gamma: float | None = None, *, delta_points: int = 21,
+                              **options: Any) -> MixedSynthesisResult:
     """Mixed H2/H∞ robust filter for a scenario's closed-loop model at δ̄.
 
     Minimizes the certified worst-case H2 norm ν of the error system (13)

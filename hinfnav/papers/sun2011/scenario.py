@@ -7,10 +7,14 @@ states, the noise matrices B and D, L, and the published filter
 sampling time, the run length, the error window) is a documented choice.
 """
 
+from __future__ import annotations
+
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ...control.feedback import LinearFeedback
 from ...core.exceptions import InputError
@@ -29,6 +33,10 @@ from ...systems.hill import (
 )
 from ...systems.uncertain import UncertainSystem
 from .constants import PAPER_K
+
+if TYPE_CHECKING:
+    from ...systems.linear import LinearSystem
+    from ...systems.measurements import LinearMeasurement
 
 __all__ = ["Scenario", "paper_scenario", "DISCRETIZATIONS"]
 
@@ -117,26 +125,26 @@ class Scenario:
         if self.duration_s < self.dt:
             raise InputError(f"duration_s must be at least one sampling time dt = {self.dt}; got {self.duration_s}")
 
-    def replace(self, **changes):
+    def replace(self, **changes: Any) -> Scenario:
         """A copy with some settings changed (validated again)."""
         return dataclasses.replace(self, **changes)
 
     @property
-    def n_steps(self):
+    def n_steps(self) -> int:
         """Number of sampling intervals, ``round(duration_s / dt)``."""
         return int(round(self.duration_s / self.dt))
 
     @property
-    def time(self):
+    def time(self) -> NDArray[np.float64]:
         """Sample times ``t_k = k T``, shape (n_steps + 1,), s."""
         return np.arange(self.n_steps + 1) * self.dt
 
-    def continuous_matrices(self, delta=0.0):
+    def continuous_matrices(self, delta: float = 0.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(A₀(ω₀(1+δ)), G₀)`` of (2), shapes (6, 6) and (6, 3)."""
         delta = as_real("delta", delta)
         return hill_matrices(self.omega0 * (1.0 + delta), self.mass)
 
-    def truth_matrices(self, delta=0.0, discretization="exact"):
+    def truth_matrices(self, delta: float = 0.0, discretization: str = "exact") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Discrete truth model ``x(k+1) = Φ x(k) + Γ u(k)`` (open loop).
 
         Parameters
@@ -163,7 +171,7 @@ class Scenario:
         A0, G0 = self.continuous_matrices(delta)
         return discretize(A0, G0, self.dt, discretization)
 
-    def design_model(self, delta_bar=None):
+    def design_model(self, delta_bar: float | None = None) -> UncertainSystem:
         """The uncertain discrete closed-loop system ψ_d of (6)–(11).
 
         ``A = I + T(A₁ + G₀K)`` (Euler, as in the paper), ``H = T H_a`` and
@@ -189,19 +197,19 @@ class Scenario:
             H, E = self.dt * Ha, Ea
         return UncertainSystem(A, self.B, measurement_matrix(), self.D, self.L, H, E, self.dt)
 
-    def design_A(self, delta=0.0):
+    def design_A(self, delta: float = 0.0) -> NDArray[np.float64]:
         """Euler closed-loop matrix with a given δ: ``I + T(A₁ + ΔA₁(δ) + G₀K)``."""
         A1, G0 = hill_matrices(self.omega0, self.mass)
         return np.eye(6) + self.dt * (A1 + delta_A1(self.omega0, delta) + G0 @ self.K)
 
-    def input_matrix_design(self):
+    def input_matrix_design(self) -> NDArray[np.float64]:
         """Input matrix of the Euler design model, ``T G₀``, shape (6, 3)."""
         _, G0 = hill_matrices(self.omega0, self.mass)
         return self.dt * G0
 
     # -- the objects the generic layers read ---------------------------------------
 
-    def system(self, delta=0.0, discretization="exact", *, closed_loop=False):
+    def system(self, delta: float = 0.0, discretization: str = "exact", *, closed_loop: bool = False) -> LinearSystem:
         """The truth dynamics as a :class:`~hinfnav.systems.LinearSystem`.
 
         Parameters
@@ -222,17 +230,18 @@ class Scenario:
         return dataclasses.replace(sysm, Phi=Phi, Gamma=Gamma)
 
     @property
-    def measurement(self):
+    def measurement(self) -> LinearMeasurement:
         """The indirect position measurement (8), ``y = [I 0] x + D v``."""
         return position_measurement(self.D)
 
-    def controller(self, maneuver=True, source="truth"):
+    def controller(self, maneuver: bool = True, source: str = "truth") -> LinearFeedback | None:
         """The orbit-maneuver law u = K x of (3) (``source="estimate"``: u = K x̂), or None without maneuver."""
         if not isinstance(maneuver, (bool, np.bool_)):
             raise InputError(f"maneuver must be True or False; got {maneuver!r}")
         return LinearFeedback(self.K, source=source, name="orbit maneuver u = Kx (3)") if maneuver else None
 
-    def lti_filter(self, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):
+    def lti_filter(self, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, *, name: str, uses_input: bool = True,
+                   design_dt: float | None = None) -> LTIFilter:
         """The filter (12) designed on this scenario's closed loop, as an estimator.
 
         ``uses_input=True`` tells it the applied thrust through
@@ -251,7 +260,8 @@ class Scenario:
             return LTIFilter(A_F, B_F, C_F, system, meas, name=name, input_matrix=self.input_matrix_design(), K=self.K)
         return LTIFilter(A_F, B_F, C_F, system, meas, name=name)
 
-    def estimator_from_design(self, design, *, verbatim=False, name="design"):
+    def estimator_from_design(self, design: SynthesisResult, *, verbatim: bool = False,
+                              name: str = "design") -> LTIFilter:
         """An estimator from a :class:`~hinfnav.design.SynthesisResult` designed for this scenario.
 
         Parameters
@@ -267,7 +277,7 @@ class Scenario:
         dt = None if design.dt is True else design.dt
         return self.lti_filter(design.A_F, design.B_F, design.C_F, name=name, uses_input=not verbatim, design_dt=dt)
 
-    def truth_model(self, maneuver=True, delta=0.0, discretization="exact"):
+    def truth_model(self, maneuver: bool = True, delta: float = 0.0, discretization: str = "exact") -> TruthModel:
         """What the simulation layer needs: system, measurement, x₀, length and the law on the true state.
 
         Parameters
