@@ -4,9 +4,11 @@
    except those whose executed copy is newer than both the notebook and every file of the package
    (an up-to-date copy is reused, so a second build executes nothing);
 2. copies the executed notebooks into ``docs/chapters/``, where myst-nb renders them with their
-   stored outputs and figures (``nb_execution_mode = "off"``: Sphinx executes nothing);
+   stored outputs and figures (``nb_execution_mode = "off"``: Sphinx executes nothing); the kernels
+   draw with matplotlib's inline backend, so every figure is stored as a PNG;
 3. runs ``sphinx-build -W --keep-going -b html docs build/html`` (warnings are errors);
-4. checks that every chapter whose executed notebook holds a figure shows an ``<img>`` in its page.
+4. checks that every chapter whose executed notebook holds a figure shows an ``<img>`` in its page,
+   and that no figure was stored as its text ``<Figure size ...>``.
 
 ``--no-notebooks`` builds the site without the chapters (seconds, not minutes); ``--jobs N`` sets
 the notebooks executed at a time (default 2). The site is then at ``build/html/index.html``.
@@ -27,6 +29,7 @@ EXECUTED = ROOT / "build" / "executed"
 CHAPTERS = ROOT / "docs" / "chapters"
 HTML = ROOT / "build" / "html"
 TIMEOUT_S = 900  # per cell, as the test suite's --nbmake-timeout
+INLINE_BACKEND = "module://matplotlib_inline.backend_inline"
 
 
 def _newest_source_mtime():
@@ -46,7 +49,11 @@ def _execute(notebook):
 
     start = time.perf_counter()
     nb = nbformat.read(notebook, as_version=4)
-    NotebookClient(nb, timeout=TIMEOUT_S, resources={"metadata": {"path": str(notebook.parent)}}).execute()
+    # --matplotlib=inline: a Figure left as a cell's value is drawn even where the notebook never imports
+    # pyplot (the package builds its figures without pyplot's global state, so nothing else registers
+    # the inline PNG formatter).
+    NotebookClient(nb, timeout=TIMEOUT_S, resources={"metadata": {"path": str(notebook.parent)}},
+                   extra_arguments=["--matplotlib=inline"]).execute()
     tmp = EXECUTED / f".{notebook.name}.tmp"
     nbformat.write(nb, tmp)
     os.replace(tmp, EXECUTED / notebook.name)
@@ -77,9 +84,13 @@ def check_figures():
     """Every chapter whose executed notebook has an image output must show an <img> in its HTML page."""
     import nbformat
 
-    missing, with_figures = [], 0
+    missing, with_figures, as_text = [], 0, []
     for nb in sorted(CHAPTERS.glob("*.ipynb")):
         cells = nbformat.read(nb, as_version=4).cells
+        if any(str(out.get("data", {}).get("text/plain", "")).startswith("<Figure size")
+               and "image/png" not in out.get("data", {})
+               for cell in cells if cell.cell_type == "code" for out in cell.get("outputs", [])):
+            as_text.append(nb.name)  # a figure stored as its text repr: the kernel did not draw inline
         has_image = any("image/png" in out.get("data", {}) or "image/svg+xml" in out.get("data", {})
                         for cell in cells if cell.cell_type == "code" for out in cell.get("outputs", []))
         if not has_image:
@@ -88,8 +99,9 @@ def check_figures():
         page = HTML / "chapters" / f"{nb.stem}.html"
         if "<img" not in page.read_text(encoding="utf-8"):
             missing.append(page.name)
-    if missing or not with_figures:
-        sys.exit(f"docs: no <img> in the rendered chapters {missing} (chapters with figures: {with_figures})")
+    if missing or as_text or not with_figures:
+        sys.exit(f"docs: no <img> in the rendered chapters {missing}, figures stored as text in {as_text} "
+                 f"(chapters with figures: {with_figures})")
     print(f"docs: {with_figures} chapters show their figures", flush=True)
 
 
@@ -105,7 +117,9 @@ def main(argv=None):
     if args.no_notebooks:
         env["HINFNAV_DOCS_NOTEBOOKS"] = "0"
     else:
-        os.environ["MPLBACKEND"] = "Agg"
+        # The kernels draw inline (PNG outputs), whatever MPLBACKEND the caller set: under Agg a figure
+        # left as a cell's value would be stored as the text "<Figure size ...>", not as an image.
+        os.environ["MPLBACKEND"] = INLINE_BACKEND
         execute_notebooks(args.jobs)
         copy_chapters()
         env["HINFNAV_DOCS_NOTEBOOKS"] = "1"
