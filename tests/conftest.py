@@ -27,6 +27,7 @@ SLOW = {
     "tests/test_design.py::test_observer_gamma_is_at_least_general_and_passes_through_sweep",
     "tests/test_design.py::test_solvers_agree_and_gamma_nondecreasing",
     "tests/test_design_corner_cases.py::test_loose_certificate_warns_with_both_numbers",
+    "tests/test_docs.py::test_docs_build_without_warnings_and_hold_the_api",
     "tests/test_generic_layers.py::test_closed_loop_on_the_estimate_converges_like_the_ideal_loop",
     "tests/test_mixed_h2hinf.py::test_front_is_monotone_and_every_point_certified",
     "tests/test_mixed_h2hinf.py::test_near_gamma_star_the_filter_reaches_the_hinf_optimum",

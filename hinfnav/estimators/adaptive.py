@@ -31,7 +31,7 @@ depend on λ). With every λ = 1 the filter is the plain EKF, exactly.
 orthogonal to κ, and none at all where κ = 0); the reading used here is
 element-wise with a floor, ``Q_ii(t_k) = Q_ii(t₀) max(f_min, (ε κᵢ)²)`` (R2):
 each channel's noise grows with the square of its own rate once
-|ε κᵢ| > √f_min, and never falls below f_min Q(t₀) (documented choice). ε
+``|ε κᵢ| > √f_min``, and never falls below f_min Q(t₀) (documented choice). ε
 carries the unit s per unit of the augmented state. Before m steps have
 passed κ uses the steps available.
 """

@@ -175,7 +175,7 @@ def quat_from_rotvec(v):
 
 
 def rotvec_from_quat(q):
-    """Rotation vector (rad) of a unit quaternion, the inverse of :func:`quat_from_rotvec` (|angle| ≤ π)."""
+    """Rotation vector (rad) of a unit quaternion, the inverse of :func:`quat_from_rotvec` (``|angle| ≤ π``)."""
     q = np.asarray(q, dtype=float)
     q = np.where(q[..., 3:] < 0, -q, q)
     s = np.linalg.norm(q[..., :3], axis=-1, keepdims=True)
@@ -387,7 +387,7 @@ class AttitudeSystem:
 
         ``ω⁺ = ω + Δt ω̇(ω, T_c + T̂)`` and ``q⁺ = exp(½ [ω̄; 0] Δt) ⊗ q`` with
         ω̄ = (ω + ω⁺)/2: second order in Δt, and cheaper than the truth's RK4.
-        With |ω| ~ 1e-4 rad/s and Δt = 1 s it differs from the RK4 step by
+        With ``|ω|`` ~ 1e-4 rad/s and Δt = 1 s it differs from the RK4 step by
         far less than a micro-radian per step.
         """
         x = np.asarray(x, dtype=float)

@@ -84,18 +84,18 @@ class FilterStats:
     euler_run_deg, torque_run_Nm : ndarray, shape (runs,)
         Per-run RMS over axes (for 95 % intervals).
     corr_rate, corr_torque : ndarray, shape (3,)
-        Correlation over runs and window of |torque error| with |dT_d/dt| and with |T_d|.
+        Correlation over runs and window of ``|torque error|`` with ``|dT_d/dt|`` and with ``|T_d|``.
     corr_rate_euler : ndarray, shape (3,)
-        Correlation of |Euler error| with |dT_d/dt| of the same axis.
+        Correlation of ``|Euler error|`` with ``|dT_d/dt|`` of the same axis.
     period_s : ndarray, shape (3,)
         Period of the strongest line of b(t) (torque error), s.
     crest_torque, crest_euler : ndarray, shape (3,)
-        max|b| / RMS(b) over the window (√2 for a sinusoid, < √2 for a flat top).
+        ``max|b| / RMS(b)`` over the window (√2 for a sinusoid, < √2 for a flat top).
     plateau_torque : ndarray, shape (3,)
-        Fraction of the window where |b| ≥ 0.8 max|b| (0.41 for a sinusoid).
+        Fraction of the window where ``|b| ≥ 0.8 max|b|`` (0.41 for a sinusoid).
     rate_elasticity : ndarray, shape (3,)
-        Slope of log|b_T| against log|dT_d/dt| over the samples with
-        |dT_d/dt| ≥ half its maximum (around the zero crossings, where the
+        Slope of ``log|b_T|`` against ``log|dT_d/dt|`` over the samples with
+        ``|dT_d/dt| ≥`` half its maximum (around the zero crossings, where the
         error peaks): 1 when the oscillating error is proportional to the
         rate (a lag), 0 for a plateau.
     t, run0, mean : ndarray or None

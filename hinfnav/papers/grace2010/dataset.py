@@ -130,7 +130,7 @@ def inertial_to_ecef(t, r, v, omega_earth=OMEGA_EARTH):
 
 
 def hill_basis(r_c, v_c):
-    """Rows x̂ (radial), ŷ (along-track), ẑ (normal) of the chief's Hill frame, and its rate |h|/|r|², eq. (G2).
+    """Rows x̂ (radial), ŷ (along-track), ẑ (normal) of the chief's Hill frame, and its rate ``|h|/|r|²``, eq. (G2).
 
     Returns
     -------
@@ -204,7 +204,7 @@ class GraceData:
 
     @property
     def orbital_rate(self):
-        """GRACE-B's mean Hill-frame rate over the day, |h|/|r|², rad/s."""
+        """GRACE-B's mean Hill-frame rate over the day, ``|h|/|r|²``, rad/s."""
         return float(np.mean(hill_basis(self.rB, self.vB)[1]))
 
     @property

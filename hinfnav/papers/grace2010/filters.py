@@ -70,11 +70,14 @@ FILTER_NAMES = ("ekf_hill", "ekf_two_body_j2", "huber_hill", "stkf_hill_accel", 
 class NonlinearPredictionEKF(ExtendedKalmanFilter):
     """EKF with a nonlinear (two-body or two-body + J2) mean prediction of the Hill state.
 
-    Parameters (besides :class:`~hinfnav.estimators.ExtendedKalmanFilter`'s)
+    Parameters
     ----------
     chief : tuple of ndarray
         GRACE-B's inertial ``(r (n, 3), v (n, 3))`` at every epoch (m, m/s).
     model : {"two_body", "two_body_j2"}
+        The nonlinear mean prediction.
+    **kwargs
+        The parameters of :class:`~hinfnav.estimators.ExtendedKalmanFilter`.
     """
 
     name = "ekf_two_body_j2"
@@ -114,7 +117,7 @@ def _quiet(fn, *args, **kwargs):
 
 
 def lmi_designs(omega0, delta_bar, Q, D, *, mixed_factor=2.0):
-    """The robust H∞ (observer form) and mixed H2/H∞ designs on ``ρ Φ(ω₀)`` with |δ| ≤ δ̄ (module notes).
+    """The robust H∞ (observer form) and mixed H2/H∞ designs on ``ρ Φ(ω₀)`` with ``|δ| ≤ δ̄`` (module notes).
 
     Parameters
     ----------

@@ -84,7 +84,7 @@ def kband_noise(data, window=11, order=3):
     1. Residual of a smooth fit: a Savitzky–Golay filter (``window`` epochs, polynomial ``order``) through
        the K-band series; the RMS residual, scaled by √(1/(1 − h₀)) for the fit's own leverage
        h₀ (the centre weight of the filter), is the white-noise σ at 10 s.
-    2. Against the POD baseline: mean (a bias), standard deviation and max of K-band − |r_A − r_B|.
+    2. Against the POD baseline: mean (a bias), standard deviation and max of ``K-band − |r_A − r_B|``.
 
     Returns
     -------

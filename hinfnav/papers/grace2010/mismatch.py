@@ -155,6 +155,6 @@ def one_step_mismatch(data, *, iterations=3, h=1e-4):
 
 
 def chief_rate_range(data):
-    """Min and max over the day of GRACE-B's instantaneous Hill rate |h|/|r|² relative to ω₀ (a δ seen directly)."""
+    """Min and max over the day of GRACE-B's instantaneous Hill rate ``|h|/|r|²`` relative to ω₀ (a δ seen directly)."""
     w = hill_basis(data.rB, data.vB)[1]
     return float(w.min() / data.orbital_rate - 1), float(w.max() / data.orbital_rate - 1)

@@ -9,8 +9,8 @@ thrust — beside the idealized u = K x, on the same noise (same seed, same
 child generators), and reports for each:
 
 * whether the maneuver converges: the final distance to the target
-  |r(t_end)| and the time after which |r| stays below ``arrive_m``;
-* the thrust: peak |F| (N), the velocity change ∫|F|/m dt (m/s) and the
+  ``|r(t_end)|`` and the time after which ``|r|`` stays below ``arrive_m``;
+* the thrust: peak ``|F|`` (N), the velocity change ``∫|F|/m dt`` (m/s) and the
   RMS thrust once the maneuver is over (the last 40 % of the run, N), which
   is where navigation noise fed through K shows;
 * the navigation error: per-axis RMS of x − x̂ over the scenario's window.
@@ -47,7 +47,7 @@ class ClosedLoopStudy:
     rows : list of dict
         One per key of :data:`CLOSED_LOOP_FILTERS`: ``key``, ``label``,
         ``final_range_m`` (mean over runs), ``arrival_s`` (mean time after
-        which |r| < arrive_m, NaN if a run never arrives), ``arrived``
+        which ``|r| < arrive_m``, NaN if a run never arrives), ``arrived``
         (fraction of runs), ``peak_thrust_N``, ``delta_v_mps``,
         ``pos_rms_m`` (3,), ``vel_rms_mps`` (3,).
     results : dict

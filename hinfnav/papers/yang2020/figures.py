@@ -111,7 +111,7 @@ def fig5(result, *, axis=0, run=0):
 
 
 def fig6(result, *, axis=0, run=0):
-    """|errors| of displacement and velocity of Algorithm 1 and Algorithm 2 (L1), standalone."""
+    """``|errors|`` of displacement and velocity of Algorithm 1 and Algorithm 2 (L1), standalone."""
     fig, axes = new_figure(2, 1, figsize=(8, 6), sharex=True)
     truth = result.dragfree_truth()[run]
     n = result.passive["alg1"].shape[1]

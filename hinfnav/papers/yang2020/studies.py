@@ -185,8 +185,8 @@ def step_response(result, *, tolerance=0.05):
     -------
     dict
         Per axis (pitch, yaw, roll): ``settling_s`` (to within ``tolerance`` of the step, after the
-        command), ``overshoot`` (fraction of the step), ``rel_attitude_peak_rad`` (largest |φ_rel| in
-        the 1000 s after the command) and ``rel_attitude_before_rad`` (largest |φ_rel| in the 1000 s before).
+        command), ``overshoot`` (fraction of the step), ``rel_attitude_peak_rad`` (largest ``|φ_rel|`` in
+        the 1000 s after the command) and ``rel_attitude_before_rad`` (largest ``|φ_rel|`` in the 1000 s before).
     """
     ref = result.reference
     on = np.nonzero(np.any(ref != 0, axis=1))[0]
@@ -346,7 +346,7 @@ def theta_readings_study(result, scenario, *, axis=0, readings=None):
     -------
     dict
         Per reading: ``theta`` (per axis), and for L1, L2, L3 the :func:`disturbance_errors` (N) plus
-        ``r_error_mean_m`` / ``r_error_end_m`` (mean and final |displacement error|, m); for L1 also
+        ``r_error_mean_m`` / ``r_error_end_m`` (mean and final ``|displacement error|``, m); for L1 also
         ``first_update_N`` (its disturbance estimate after the first update) and ``truth_first_N``.
         Also ``first_saturated_step``, ``saturated_fraction`` and ``p0_disturbance_std_N`` (√P₀ of F).
     """
