@@ -28,7 +28,7 @@ NOTEBOOKS = ROOT / "notebooks"
 EXECUTED = ROOT / "build" / "executed"
 CHAPTERS = ROOT / "docs" / "chapters"
 HTML = ROOT / "build" / "html"
-TIMEOUT_S = 900  # per cell, as the test suite's --nbmake-timeout
+TIMEOUT_S = 900  # per cell, s (the test suite's notebook items use the same)
 INLINE_BACKEND = "module://matplotlib_inline.backend_inline"
 
 
@@ -42,22 +42,33 @@ def _is_up_to_date(notebook, package_mtime):
     return out.exists() and out.stat().st_mtime > max(notebook.stat().st_mtime, package_mtime)
 
 
-def _execute(notebook):
-    """Execute one notebook in its own folder (as the test suite does) and write the executed copy atomically."""
+def execute_notebook(notebook, executed_dir=EXECUTED):
+    """Execute one notebook in its own folder and write the executed copy atomically into ``executed_dir``.
+
+    The test suite's notebook items (``notebooks/conftest.py``) call this too, so a CI run executes each
+    notebook once: the docs then reuse the copies the tests wrote. Returns ``(name, seconds)``; a failing
+    cell raises nbclient's ``CellExecutionError`` and writes no copy.
+    """
     import nbformat
     from nbclient import NotebookClient
 
     start = time.perf_counter()
     nb = nbformat.read(notebook, as_version=4)
-    # --matplotlib=inline: a Figure left as a cell's value is drawn even where the notebook never imports
-    # pyplot (the package builds its figures without pyplot's global state, so nothing else registers
-    # the inline PNG formatter).
-    NotebookClient(nb, timeout=TIMEOUT_S, resources={"metadata": {"path": str(notebook.parent)}},
-                   extra_arguments=["--matplotlib=inline"]).execute()
-    tmp = EXECUTED / f".{notebook.name}.tmp"
+    # --matplotlib=inline and the inline backend in the kernel's environment: a Figure left as a cell's
+    # value is drawn as a PNG even where the notebook never imports pyplot (the package builds its figures
+    # without pyplot's global state), whatever MPLBACKEND the caller has (CI sets Agg).
+    client = NotebookClient(nb, timeout=TIMEOUT_S, resources={"metadata": {"path": str(notebook.parent)}},
+                            extra_arguments=["--matplotlib=inline"])
+    client.execute(env=dict(os.environ, MPLBACKEND=INLINE_BACKEND))
+    executed_dir = Path(executed_dir)
+    executed_dir.mkdir(parents=True, exist_ok=True)
+    tmp = executed_dir / f".{notebook.name}.{os.getpid()}.tmp"
     nbformat.write(nb, tmp)
-    os.replace(tmp, EXECUTED / notebook.name)
+    os.replace(tmp, executed_dir / notebook.name)
     return notebook.name, time.perf_counter() - start
+
+
+_execute = execute_notebook
 
 
 def execute_notebooks(jobs):
@@ -117,10 +128,7 @@ def main(argv=None):
     if args.no_notebooks:
         env["HINFNAV_DOCS_NOTEBOOKS"] = "0"
     else:
-        # The kernels draw inline (PNG outputs), whatever MPLBACKEND the caller set: under Agg a figure
-        # left as a cell's value would be stored as the text "<Figure size ...>", not as an image.
-        os.environ["MPLBACKEND"] = INLINE_BACKEND
-        execute_notebooks(args.jobs)
+        execute_notebooks(args.jobs)  # the kernels draw inline (execute_notebook), whatever MPLBACKEND is
         copy_chapters()
         env["HINFNAV_DOCS_NOTEBOOKS"] = "1"
     t_sphinx = time.perf_counter()

@@ -6,7 +6,7 @@ that the stored sweep does not hold) into a temporary folder. Each must run,
 and the labels it prints must name the new values, not the stored ones. The
 expected strings are the parameters themselves: a label that hard-coded the
 stored value (δ̄ = 0.05, 20 runs, seed 0, mixture noise) fails these checks.
-The normal ``--nbmake`` run executes every notebook as stored.
+The normal run (notebooks/conftest.py) executes every notebook as stored.
 
 The four executions run two at a time: about 40 s of CPU in all (small runs).
 """
