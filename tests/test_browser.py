@@ -137,6 +137,19 @@ def _open_and_run_all(driver, lab, name):
     # the menu item is disabled until the notebook and its kernel are ready: click again until cells start
     for _attempt in range(6):
         driver.find_element(By.CSS_SELECTOR, "body").send_keys(Keys.ESCAPE)  # close a menu left open
+        dialogs = [e.text for e in driver.find_elements(By.CSS_SELECTOR, ".jp-Dialog")]
+        if dialogs and all(d.startswith("Select Kernel") and "Python 3" in d for d in dialogs):
+            # shown when the kernel specs load after the notebook: accept the preselected Python 3 kernel
+            driver.find_element(By.CSS_SELECTOR, ".jp-Dialog .jp-mod-accept").click()
+            _wait(lambda: not driver.find_elements(By.CSS_SELECTOR, ".jp-Dialog"), 30, "the kernel dialog to close")
+            _wait(lambda: driver.find_elements(By.CSS_SELECTOR, idle), 120, "the kernel to start")
+            dialogs = []
+        if dialogs:
+            _screenshot(driver, f"FAILED_{Path(name).stem}_dialog.png", check=False)
+            raise AssertionError(f"JupyterLab shows a dialog over {name}: {dialogs}")
+        cells = driver.find_elements(By.CSS_SELECTOR, panel + ".jp-Cell .jp-InputPrompt")
+        if cells:  # focus the notebook in front, so that the Run menu acts on it
+            cells[0].click()
         menu = _wait(lambda: [e for e in driver.find_elements(By.CSS_SELECTOR, ".lm-MenuBar-itemLabel")
                               if e.text == "Run"], 30, "the Run menu")
         menu[0].click()
@@ -148,6 +161,9 @@ def _open_and_run_all(driver, lab, name):
             break
         except AssertionError:
             continue
+    else:
+        _screenshot(driver, f"FAILED_{Path(name).stem}_run_all.png", check=False)
+        raise AssertionError(f"Run ▸ Run All Cells did not start {name}'s cells")
     n_code = len(driver.find_elements(By.CSS_SELECTOR, panel + ".jp-CodeCell"))
 
     def done():
@@ -191,7 +207,7 @@ def test_paper_chapter_runs_in_jupyterlab(lab, browser):
 
     images = browser.find_elements(By.CSS_SELECTOR, ".jp-NotebookPanel:not(.lm-mod-hidden) .jp-OutputArea-output img")
     assert images, "the paper chapter's figures were not rendered"
-    browser.execute_script("arguments[0].scrollIntoView({block: 'center'});", images[0])
+    browser.execute_script("arguments[0].scrollIntoView({block: 'start'});", images[0])
     _screenshot(browser, "01_model_and_scenario.png")
 
 
