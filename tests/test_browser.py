@@ -120,6 +120,7 @@ def _wait(predicate, timeout, what):
 
 def _open_and_run_all(driver, lab, name):
     """Open a notebook in JupyterLab, choose Run ▸ Run All Cells, wait until every code cell has run."""
+    from selenium.common.exceptions import WebDriverException
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
 
@@ -149,7 +150,10 @@ def _open_and_run_all(driver, lab, name):
             raise AssertionError(f"JupyterLab shows a dialog over {name}: {dialogs}")
         cells = driver.find_elements(By.CSS_SELECTOR, panel + ".jp-Cell .jp-InputPrompt")
         if cells:  # focus the notebook in front, so that the Run menu acts on it
-            cells[0].click()
+            try:
+                cells[0].click()
+            except WebDriverException:  # not clickable yet (scrolled, covered): the retry clicks again
+                pass
         menu = _wait(lambda: [e for e in driver.find_elements(By.CSS_SELECTOR, ".lm-MenuBar-itemLabel")
                               if e.text == "Run"], 30, "the Run menu")
         menu[0].click()
@@ -212,6 +216,7 @@ def test_paper_chapter_runs_in_jupyterlab(lab, browser):
 
 
 def test_interactive_chapter_gamma_follows_the_slider(lab, browser):
+    from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
 
@@ -230,9 +235,9 @@ def test_interactive_chapter_gamma_follows_the_slider(lab, browser):
     handle = browser.find_element(By.CSS_SELECTOR, panel + ".widget-slider .noUi-handle")
     browser.execute_script("arguments[0].scrollIntoView({block: 'start'});", handle)
     _screenshot(browser, "91_interactive_before.png")
-    handle.click()
-    for _ in range(19):  # δ̄: 0.05 → 1.0 in steps of 0.05
-        handle.send_keys(Keys.ARROW_RIGHT)
+    # the keyboard on the slider's handle, as a reader would use it (focus by script: no click needed)
+    browser.execute_script("arguments[0].focus();", handle)
+    ActionChains(browser).send_keys(*[Keys.ARROW_RIGHT] * 19).perform()  # δ̄: 0.05 → 1.0 in steps of 0.05
     after = _wait(lambda: (t := gamma_text()) and t != before and "δ̄ = 1)" in t and t, 120,
                   "the certified γ to follow the slider to δ̄ = 1")
     g_before = float(re.search(r"certified γ = ([0-9.]+)", before).group(1))
