@@ -11,12 +11,8 @@ import pytest
 from scipy.stats import truncnorm
 
 import hinfnav as hn
-from hinfnav.estimators.extended_state import (
-    ExtendedStateKalmanFilter,
-    FusedExtendedStateFilter,
-    SaturatedExtendedStateFilter,
-    theta_star,
-)
+from hinfnav.estimators.extended_state import ExtendedStateKalmanFilter, theta_star
+from hinfnav.estimators.saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
 from hinfnav.papers.yang2020 import Scenario, build_alg1, build_alg2, build_fused
 from hinfnav.sim import simulate_truth
 from hinfnav.systems import LinearMeasurement

@@ -22,13 +22,7 @@ SUBPACKAGES = (
 )
 
 #: Exported names not yet annotated, with why (each is listed so that the test still fails on any other).
-#: hinfnav/estimators/extended_state.py is at the 600-line module limit (tests/test_layers.py) and is
-#: being split in the estimators' restructuring; its signatures are annotated after that split.
-NOT_YET = frozenset({
-    "hinfnav.estimators.ExtendedStateKalmanFilter",
-    "hinfnav.estimators.SaturatedExtendedStateFilter",
-    "hinfnav.estimators.FusedExtendedStateFilter",
-})
+NOT_YET = frozenset()
 
 _SKIPPED_KINDS = (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)
 

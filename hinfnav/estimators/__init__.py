@@ -8,7 +8,8 @@ from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_est
 from .huber import HuberUpdate, huber_update
 from .adaptive import RateAdaptive, StrongTracking
 from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
-from .extended_state import ExtendedStateKalmanFilter, FusedExtendedStateFilter, SaturatedExtendedStateFilter
+from .extended_state import ExtendedStateKalmanFilter
+from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
 from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
 from .huber_filter import HuberCorrection, HuberFilter
 from .recursive_hinf import RecursiveHInfinityFilter

@@ -17,11 +17,8 @@ in the contract suite is ``scenario.truth_model(SUBSYSTEM_OF[name])``.
 import numpy as np
 
 from ...core.exceptions import InputError
-from ...estimators.extended_state import (
-    ExtendedStateKalmanFilter,
-    FusedExtendedStateFilter,
-    SaturatedExtendedStateFilter,
-)
+from ...estimators.extended_state import ExtendedStateKalmanFilter
+from ...estimators.saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
 from ...estimators.registry import register_estimator
 from ...systems.linear import LinearSystem
 from ...systems.measurements import LinearMeasurement
