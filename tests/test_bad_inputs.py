@@ -96,8 +96,8 @@ API_ROWS = [
     _row("seed-bool", lambda c: hn.simulate(SHORT, "published", seed=True), r"\bseed\b"),
     _row("seed-str", lambda c: hn.simulate(SHORT, "published", seed="3"), r"\bseed\b"),
     # was: numpy SeedSequence ValueError / TypeError
-    _row("synthesize-seed-negative", lambda c: hn.synthesize(A2, B2, C2, D2, L2, seed=-1), r"\bseed\b"),
-    _row("synthesize-seed-str", lambda c: hn.synthesize(A2, B2, C2, D2, L2, seed="x"), r"\bseed\b"),
+    _row("synthesize-seed-negative", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2), seed=-1), r"\bseed\b"),
+    _row("synthesize-seed-str", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2), seed="x"), r"\bseed\b"),
     # -- runs and batch_size ------------------------------------------------------------------------------
     _row("runs-0", lambda c: hn.simulate(SHORT, "published", runs=0), r"\bruns\b"),
     _row("runs-float", lambda c: hn.simulate(SHORT, "published", runs=2.5), r"\bruns\b"),
@@ -139,7 +139,7 @@ API_ROWS = [
     # was: "C_F must be invertible" (C_F is the designed filter's; the user gave L)
     _row("L-singular-designed", lambda c: sun.make_estimator("designed", hn.Scenario(L=np.zeros((6, 6)))), r"\bL\b"),
     _row("L-3x6-designed", lambda c: sun.make_estimator("designed", hn.Scenario(L=np.eye(3, 6))), r"\bL\b"),
-    _row("L-singular-observer", lambda c: hn.synthesize(A2, B2, C2, D2, np.zeros((2, 2)), form="observer"), r"\bL\b"),
+    _row("L-singular-observer", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, np.zeros((2, 2))), form="observer"), r"\bL\b"),
     # -- noise ---------------------------------------------------------------------------------------------
     _row("noise-name", lambda c: hn.simulate(SHORT, "published", noise="pink"), r"\bnoise\b"),
     _row("noise-int", lambda c: hn.simulate(SHORT, "published", noise=3), r"\bnoise\b"),
@@ -173,16 +173,16 @@ API_ROWS = [
     _row("ekf-P0-negative", lambda c: sun.EKF(SHORT, P0=-np.eye(6)), r"\bP0\b"),
     _row("ekf-output", lambda c: sun.EKF(SHORT, output="smoothed"), r"\boutput\b"),
     # -- designs -------------------------------------------------------------------------------------------
-    _row("synthesize-A-nonsquare", lambda c: hn.synthesize(np.zeros((2, 3)), B2, C2, D2, L2), r"\bA\b"),
-    _row("synthesize-D-rows", lambda c: hn.synthesize(A2, B2, C2, np.eye(2), L2), r"\bD\b"),
-    _row("synthesize-L-cols", lambda c: hn.synthesize(A2, B2, C2, D2, np.eye(2, 3)), r"\bL\b"),
-    _row("synthesize-unstable-plant", lambda c: hn.synthesize(2 * np.eye(2), B2, C2, D2, L2), r"\bA\b",
+    _row("synthesize-A-nonsquare", lambda c: hn.synthesize(hn.UncertainSystem(np.zeros((2, 3)), B2, C2, D2, L2)), r"\bA\b"),
+    _row("synthesize-D-rows", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, np.eye(2), L2)), r"\bD\b"),
+    _row("synthesize-L-cols", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, np.eye(2, 3))), r"\bL\b"),
+    _row("synthesize-unstable-plant", lambda c: hn.synthesize(hn.UncertainSystem(2 * np.eye(2), B2, C2, D2, L2)), r"\bA\b",
          UnstablePlantError),
-    _row("synthesize-H-without-E", lambda c: hn.synthesize(A2, B2, C2, D2, L2, H=np.eye(2)), r"\bE\b"),
-    _row("synthesize-solver", lambda c: hn.synthesize(A2, B2, C2, D2, L2, solver="MOSEK"), r"\bsolver\b"),
-    _row("synthesize-options-dict", lambda c: hn.synthesize(A2, B2, C2, D2, L2, options={"solvers": ["CLARABEL"]}),
+    _row("synthesize-H-without-E", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2, H=np.eye(2))), r"\bE\b"),
+    _row("synthesize-solver", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2), solver="MOSEK"), r"\bsolver\b"),
+    _row("synthesize-options-dict", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2), options={"solvers": ["CLARABEL"]}),
          r"\boptions\b"),
-    _row("synthesize-structure", lambda c: hn.synthesize(A2, B2, C2, D2, L2, structure="block"), r"\bstructure\b"),
+    _row("synthesize-structure", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, L2), structure="block"), r"\bstructure\b"),
     # was: TypeError synthesize() got an unexpected keyword argument
     _row("design-option-unknown", lambda c: sun.design_for_scenario(None, 0.05, foo=1), r"\bfoo\b"),
     _row("design-delta_bar-nan", lambda c: sun.design_for_scenario(None, np.nan), r"\bdelta_bar\b"),

@@ -53,7 +53,7 @@ def paper_design(scenario):
 def test_no_measurement_information_known_answer(a, b, l):
     # C = 0: y = D v carries no information, so the best filter outputs z_f = 0 and
     # γ* = ‖L(zI − A)⁻¹B‖∞ = |l b|/(1 − |a|) (closed form: any use of y only adds the v channel)
-    res = synthesize([[a]], [[b]], [[0.0]], [[1.0]], [[l]])
+    res = synthesize(UncertainSystem([[a]], [[b]], [[0.0]], [[1.0]], [[l]]))
     expected = abs(l * b) / (1 - abs(a))
     assert res.gamma == pytest.approx(expected, rel=1e-5)
     assert res.gamma >= expected * (1 - 1e-9)  # a certified bound is never below the optimum
@@ -64,7 +64,7 @@ def test_no_measurement_information_known_answer(a, b, l):
 def test_noise_free_measurement_known_answer(a, b):
     # C = 1, D = 0, L = 1: the strictly proper filter (12) sees y up to k − 1, so e(k) keeps
     # b w(k − 1): γ* = |b| (closed form), reached by z_f(k) = a y(k − 1)
-    res = synthesize([[a]], [[b]], [[1.0]], [[0.0]], [[1.0]])
+    res = synthesize(UncertainSystem([[a]], [[b]], [[1.0]], [[0.0]], [[1.0]]))
     assert res.gamma == pytest.approx(abs(b), rel=1e-5)
     # the optimal filter predicts a·y: C_F (zI − A_F)⁻¹ B_F ≈ a/z
     tf = res.C_F @ np.linalg.solve(2.0 * np.eye(1) - res.A_F, res.B_F)
@@ -75,7 +75,7 @@ def test_noise_free_measurement_known_answer(a, b):
 def test_uncertain_scalar_known_answer(a, h, e):
     # C = 0 again, x⁺ = (a + h f e) x + w: the worst admissible f is +1 (positive system), so
     # γ* = 1/(1 − a − |h e|) (closed form); Lemma 2 is lossless for one scalar uncertainty
-    res = synthesize([[a]], [[1.0]], [[0.0]], [[1.0]], [[1.0]], [[h]], [[e]])
+    res = synthesize(UncertainSystem([[a]], [[1.0]], [[0.0]], [[1.0]], [[1.0]], [[h]], [[e]]))
     assert res.gamma == pytest.approx(1 / (1 - a - abs(h * e)), rel=1e-5)
     assert res.verified_norm == pytest.approx(1 / (1 - a - abs(h * e)), rel=1e-6)  # F = +1 is sampled
 
@@ -87,7 +87,7 @@ def test_random_uncertain_systems_are_certified(seed, random_uncertain):
     rng = np.random.default_rng(seed)
     A, B, C, D, L, H, E = random_uncertain(rng, size=[0.02, 0.1, 0.3][seed % 3])
     try:
-        res = synthesize(A, B, C, D, L, H, E, seed=rng)
+        res = synthesize(UncertainSystem(A, B, C, D, L, H, E), seed=rng)
     except (InfeasibleLMIError, CertificationError, UnstablePlantError) as exc:
         assert str(exc)
         return
@@ -151,15 +151,15 @@ def test_prepare_uncertainty_drops_zero_columns_and_balances(scenario):
 
 def test_paper_design_is_certified(paper_design, scenario):
     res = paper_design
-    assert res.delta_bar == 0.05
-    assert 0.05 in res.deltas and -0.05 in res.deltas and 0.0 in res.deltas
+    assert res.uncertainty_bound == 0.05
+    assert 0.05 in res.sample_values and -0.05 in res.sample_values and 0.0 in res.sample_values
     assert res.verified_norm <= res.gamma
     assert res.spectral_radius < 1
     # the certified γ and the solver's agree to 1e-4 (rtol of the synthesis)
     assert res.gamma == pytest.approx(res.lmi_gamma, rel=1e-4)
     # the samples are the δ grid, carried as a SampleSet (labels and δ of each sample)
-    assert res.sample_labels[int(np.argmin(np.abs(res.deltas - 0.05)))] == "δ = 0.05"
-    assert res.worst_delta in res.deltas
+    assert res.sample_labels[int(np.argmin(np.abs(res.sample_values - 0.05)))] == "δ = 0.05"
+    assert res.worst_value in res.sample_values
     # independent recomputation of the sampled worst case at the vertices (slycot and BBBS)
     s = scenario.design_model(0.05)
     for d in (-0.05, 0.05):
@@ -250,36 +250,36 @@ def test_delta_grid_contains_vertices_and_zero():
 
 def test_shape_mismatch_names_parameter():
     with pytest.raises(InputError, match="B must have shape 2x"):
-        synthesize(np.eye(2) * 0.5, np.ones((3, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
+        synthesize(UncertainSystem(np.eye(2) * 0.5, np.ones((3, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2)))
     with pytest.raises(InputError, match="D must have shape 1x"):
-        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((2, 1)), np.eye(2))
+        synthesize(UncertainSystem(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((2, 1)), np.eye(2)))
     with pytest.raises(InputError, match="E must have shape"):
-        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2), np.ones((2, 1)), np.ones((2, 2)))
+        synthesize(UncertainSystem(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2), np.ones((2, 1)), np.ones((2, 2))))
 
 
 def test_non_finite_entries_name_parameter():
     A = np.eye(2) * 0.5
     A[0, 1] = np.inf
     with pytest.raises(InputError, match="A must contain only finite"):
-        synthesize(A, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
+        synthesize(UncertainSystem(A, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2)))
     with pytest.raises(InputError, match="L must contain only finite"):
-        synthesize(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), [[np.nan, 0], [0, 1]])
+        synthesize(UncertainSystem(np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), [[np.nan, 0], [0, 1]]))
 
 
 def test_h_without_e_and_bad_options():
     args = (np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)), np.eye(2))
     with pytest.raises(InputError, match="H and E"):
-        synthesize(*args, H=np.ones((2, 1)))
+        synthesize(UncertainSystem(*args, H=np.ones((2, 1))))
     with pytest.raises(InputError, match="solver"):
-        synthesize(*args, solver="MOSEKX")
+        synthesize(UncertainSystem(*args), solver="MOSEKX")
     with pytest.raises(InputError, match="dt"):
-        synthesize(*args, dt=-1.0)
+        synthesize(UncertainSystem(*args, dt=-1.0))
     with pytest.raises(InputError, match="structure"):
-        synthesize(*args, structure="block")
+        synthesize(UncertainSystem(*args), structure="block")
     with pytest.raises(InputError, match=r"uncertainty_samples\[0\] must be a contraction"):
-        synthesize(*args, H=np.ones((2, 1)) * 0.1, E=np.ones((1, 2)) * 0.1, uncertainty_samples=[[[2.0]]])
+        synthesize(UncertainSystem(*args, H=np.ones((2, 1)) * 0.1, E=np.ones((1, 2)) * 0.1), uncertainty_samples=[[[2.0]]])
     with pytest.raises(InputError, match=r"uncertainty_samples\[0\] must be diagonal"):
-        synthesize(*args, H=np.eye(2) * 0.1, E=np.eye(2) * 0.1, structure="diagonal", uncertainty_samples=[[[0.5, 0.5], [0, 0]]])
+        synthesize(UncertainSystem(*args, H=np.eye(2) * 0.1, E=np.eye(2) * 0.1), structure="diagonal", uncertainty_samples=[[[0.5, 0.5], [0, 0]]])
 
 
 def test_no_maneuver_hill_model_is_rejected_with_explanation(scenario):
@@ -289,7 +289,7 @@ def test_no_maneuver_hill_model_is_rejected_with_explanation(scenario):
     A = np.eye(6) + sc.dt * A1
     s = sc.design_model(0.0)
     with pytest.raises(UnstablePlantError) as info:
-        synthesize(A, s.B, s.C, s.D, s.L)
+        synthesize(UncertainSystem(A, s.B, s.C, s.D, s.L))
     msg = str(info.value)
     for phrase in ("Lemma 1", "plant state", "no finite γ", "form='observer'", "u = Kx"):
         assert phrase in msg
@@ -299,14 +299,14 @@ def test_no_maneuver_hill_model_is_rejected_with_explanation(scenario):
 def test_plant_unstable_at_a_vertex_is_rejected():
     # stable nominally (0.9) but a + h e = 1.1 at F = +1 (a sampled vertex)
     with pytest.raises(UnstablePlantError, match=r"sample \d+"):
-        synthesize([[0.9]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[0.2]], [[1.0]])
+        synthesize(UncertainSystem([[0.9]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[0.2]], [[1.0]]))
 
 
 def test_infeasible_lmi_carries_solver_status():
     # 0.5 + f with |f| ≤ 1 reaches 1.5: no quadratic Lyapunov function exists, but only F = 0 is
     # sampled, so the plant check passes and the LMI itself must report infeasibility
     with pytest.raises(InfeasibleLMIError, match="status"):
-        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], uncertainty_samples=[[[0.0]]])
+        synthesize(UncertainSystem([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]), uncertainty_samples=[[[0.0]]])
 
 
 def test_certification_failure_is_reported(monkeypatch):
@@ -316,7 +316,7 @@ def test_certification_failure_is_reported(monkeypatch):
 
     monkeypatch.setattr(robust_hinf, "_rebuild_and_certify", refuse)
     with pytest.raises(CertificationError, match="forced refusal"):
-        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], options=SolverOptions(method="minimize"))
+        synthesize(UncertainSystem([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]), options=SolverOptions(method="minimize"))
 
 
 def test_solver_options():
@@ -324,19 +324,19 @@ def test_solver_options():
     assert SolverOptions().solvers == ("CLARABEL", "CVXOPT")
     assert SolverOptions.only("clarabel").solvers == ("CLARABEL",)
     assert SolverOptions(solvers="cvxopt").solvers == ("CVXOPT",)
-    res = synthesize([[0.5]], [[1.0]], [[0.0]], [[1.0]], [[1.0]], options=SolverOptions.only("CLARABEL", method="minimize"))
+    res = synthesize(UncertainSystem([[0.5]], [[1.0]], [[0.0]], [[1.0]], [[1.0]]), options=SolverOptions.only("CLARABEL", method="minimize"))
     assert res.solver == "CLARABEL" and res.method == "minimize"
     args = ([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]])
     with pytest.raises(InputError, match="not both"):
-        synthesize(*args, solver="CLARABEL", options=SolverOptions())
+        synthesize(UncertainSystem(*args), solver="CLARABEL", options=SolverOptions())
     with pytest.raises(InputError, match="options must be a hinfnav.SolverOptions"):
-        synthesize(*args, options={"method": "minimize"})
+        synthesize(UncertainSystem(*args), options={"method": "minimize"})
     with pytest.raises(InputError, match="unknown method 'newton'"):
         SolverOptions(method="newton")
     with pytest.raises(InputError, match="rtol must be > 0"):
         SolverOptions(rtol=0.0)
     with pytest.raises(TypeError, match="method"):
-        synthesize(*args, method="minimize")
+        synthesize(UncertainSystem(*args), method="minimize")
 
 
 def test_errors_share_the_base_class():
@@ -449,7 +449,7 @@ def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_desig
     assert observer.results[1].variables["lmi20_gamma"] == pytest.approx(0.361529, rel=1e-4)
     for r in observer.results:
         assert r.verified_norm <= r.gamma and r.spectral_radius < 1
-        s = sc.design_model(r.delta_bar)
+        s = sc.design_model(r.uncertainty_bound)
         assert _rel(r.A_F - (s.A + r.B_F @ s.C), r.A_F) < 1e-9
 
 
@@ -460,8 +460,8 @@ def test_observer_form_on_random_uncertain_systems(seed, random_uncertain):
     rng = np.random.default_rng(100 + seed)
     A, B, C, D, L, H, E = random_uncertain(rng, l=3, size=0.05)
     try:
-        gen = synthesize(A, B, C, D, L, H, E, seed=1)
-        obs = synthesize(A, B, C, D, L, H, E, seed=1, form="observer")
+        gen = synthesize(UncertainSystem(A, B, C, D, L, H, E), seed=1)
+        obs = synthesize(UncertainSystem(A, B, C, D, L, H, E), seed=1, form="observer")
     except (InfeasibleLMIError, CertificationError, UnstablePlantError) as exc:
         assert str(exc)
         return
@@ -500,18 +500,36 @@ def test_observer_design_report_and_infeasibility():
     # the infeasible scalar example of test_infeasible_lmi_carries_solver_status stays infeasible, and says
     # the observer constraints were imposed
     with pytest.raises(InfeasibleLMIError, match="observer-form constraints"):
-        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], uncertainty_samples=[[[0.0]]], form="observer")
+        synthesize(UncertainSystem([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]), uncertainty_samples=[[[0.0]]], form="observer")
 
 
 def test_bad_form_and_non_square_L_are_rejected(scenario):
     args = (np.eye(2) * 0.5, np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)))
     with pytest.raises(InputError, match="form"):
-        synthesize(*args, np.eye(2), form="luenberger")
+        synthesize(UncertainSystem(*args, np.eye(2)), form="luenberger")
     with pytest.raises(InputError, match="form"):
-        synthesize(*args, np.eye(2), form=None)
+        synthesize(UncertainSystem(*args, np.eye(2)), form=None)
     with pytest.raises(InputError, match=r"form='observer'.*L must be square"):
-        synthesize(*args, np.ones((1, 2)), form="observer")
+        synthesize(UncertainSystem(*args, np.ones((1, 2))), form="observer")
     with pytest.raises(InputError, match=r"form='observer'.*L is singular"):
-        synthesize(*args, np.ones((2, 2)), form="observer")
+        synthesize(UncertainSystem(*args, np.ones((2, 2))), form="observer")
     with pytest.raises(InputError, match="form"):
         design_for_scenario(scenario, 0.05, form="Observer")
+
+
+def test_loose_matrices_are_deprecated_and_give_the_same_design():
+    # issue 23: synthesize takes an UncertainSystem; the seven loose matrices still work for one release, with a
+    # DeprecationWarning, and give the same filter (same data, same solver path: exact equality expected)
+    A, B, C, D, L, H, E = [[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[0.2]], [[1.0]]
+    new = synthesize(UncertainSystem(A, B, C, D, L, H, E, dt=0.1))
+    with pytest.warns(DeprecationWarning, match=r"UncertainSystem\(A, B, C, D, L, H, E, dt=T\)"):
+        old = synthesize(A, B, C, D, L, H=H, E=E, dt=0.1)
+    assert old.gamma == new.gamma and np.array_equal(old.A_F, new.A_F) and old.dt == new.dt == 0.1
+    with pytest.warns(DeprecationWarning):
+        assert synthesize(A, B, C, D, L).dt is True  # the old default: discrete, sampling time unspecified
+    with pytest.raises(InputError, match=r"\bdt\b.*system"):
+        synthesize(UncertainSystem(A, B, C, D, L), dt=0.1)
+    with pytest.raises(InputError, match="UncertainSystem alone"):
+        synthesize(UncertainSystem(A, B, C, D, L), B)
+    with pytest.raises(InputError, match="system must be a hinfnav UncertainSystem"):
+        synthesize("plant")

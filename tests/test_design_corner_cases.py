@@ -35,8 +35,8 @@ def test_noise_scaled_system_designs_and_certifies(random_uncertain):
     # without the normalisation the solvers still fail here, but the γ-free part (scaled) is found feasible,
     # so the error is no longer "infeasible"
     with pytest.raises(CertificationError):
-        synthesize(A, Bs, C, Ds, L, H, E, options=SolverOptions(normalize_above=float("inf")))
-    res = synthesize(A, Bs, C, Ds, L, H, E)
+        synthesize(UncertainSystem(A, Bs, C, Ds, L, H, E), options=SolverOptions(normalize_above=float("inf")))
+    res = synthesize(UncertainSystem(A, Bs, C, Ds, L, H, E))
     system = UncertainSystem(A, Bs, C, Ds, L, H, E)
     # the certificate is that of the ORIGINAL data: LMI (20) with B × 1000, D ÷ 1000 at the returned variables
     # (original units), tested here after our own power-of-two equilibration of rows and columns (exact), and
@@ -68,7 +68,7 @@ def test_paper_model_is_not_normalised(scenario):
 def test_infeasible_is_confirmed_on_the_gamma_free_part():
     # a truly infeasible problem (0.5 + f, |f| ≤ 1, reaches 1.5) is still reported, with the confirmation named
     with pytest.raises(InfeasibleLMIError, match="γ-free part"):
-        synthesize([[0.5]], [[1000.0]], [[1.0]], [[1e-3]], [[1.0]], [[1.0]], [[1.0]], uncertainty_samples=[[[0.0]]])
+        synthesize(UncertainSystem([[0.5]], [[1000.0]], [[1.0]], [[1e-3]], [[1.0]], [[1.0]], [[1.0]]), uncertainty_samples=[[[0.0]]])
 
 
 # ------------------------------------------------------------------ loose certificates
@@ -85,7 +85,7 @@ def test_loose_certificate_is_tightened(lightly_damped):
     # harder (CVXOPT's full method) finds a filter certified within 1e-4 of its own sampled norm (3.2806)
     with warnings.catch_warnings():
         warnings.simplefilter("error", LooseBoundWarning)
-        res = synthesize(*lightly_damped(0))
+        res = synthesize(UncertainSystem(*lightly_damped(0)))
     assert any("trying harder" in a for a in res.attempts)
     assert res.verified_norm <= res.gamma < 1.001 * res.verified_norm
     assert res.gamma == pytest.approx(3.2806, rel=1e-3)  # measured (November 2026)
@@ -95,7 +95,7 @@ def test_loose_certificate_warns_with_both_numbers(lightly_damped):
     # seed 1: no solver certifies a point near its own optimum (3.2601, uncertified); the best certified γ stays
     # thousands of times the sampled norm, so the user is warned with both numbers
     with pytest.warns(LooseBoundWarning) as record:
-        res = synthesize(*lightly_damped(1))
+        res = synthesize(UncertainSystem(*lightly_damped(1)))
     msg = str(record[0].message)
     assert f"{res.gamma:.6g}" in msg and f"{res.verified_norm:.6g}" in msg
     assert res.gamma > 2 * res.verified_norm and res.verified_norm <= res.gamma
@@ -168,7 +168,7 @@ def test_scs_warns_with_its_looseness():
     # the point of the test)
     with pytest.warns(SolverAccuracyWarning, match=r"SCS.*6\.55.*0\.3586"):
         with pytest.raises(CertificationError):
-            synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], options=SolverOptions.only("SCS", method="minimize"))
+            synthesize(UncertainSystem([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]), options=SolverOptions.only("SCS", method="minimize"))
     with warnings.catch_warnings():
         warnings.simplefilter("error", SolverAccuracyWarning)  # and the default solvers do not warn
-        synthesize([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], options=SolverOptions(method="minimize"))
+        synthesize(UncertainSystem([[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]), options=SolverOptions(method="minimize"))

@@ -27,7 +27,7 @@ def run_cli(capsys, *args):
 
 @pytest.fixture(scope="module")
 def di_file(tmp_path_factory):
-    res = hn.synthesize(A_DI, B_DI, C_DI, 0.1 * np.eye(2), np.eye(4), form="observer", dt=T)
+    res = hn.synthesize(hn.UncertainSystem(A_DI, B_DI, C_DI, 0.1 * np.eye(2), np.eye(4), dt=T), form="observer")
     return hn.save_design(res, tmp_path_factory.mktemp("d") / "di.json"), res
 
 
@@ -127,3 +127,23 @@ def test_h2_design_from_file_saves_and_recertifies(tmp_path, capsys):
     assert rep["objective"] == "h2" and rep["verified_worst_norm"] <= rep["gamma"]
     again = hn.recertify(save)
     assert again["ok"] and again["objective"] == "h2", again["reasons"]
+
+
+def test_a_file_saved_before_the_generic_names_still_loads(tmp_path):
+    # tests/data/designs/...98adc2f.json: saved by hinfnav at commit 98adc2f (certificate keys "delta_bar",
+    # "deltas"); it loads, checks against the paper's scenario, and keeps its bound and grid (stored values)
+    from hinfnav.papers.sun2011 import load_design
+
+    path = ROOT / "tests" / "data" / "designs" / "sun2011_dbar0.3_design2_98adc2f.json"
+    res = load_design(path)
+    stored = json.loads(path.read_text())["certificate"]
+    assert res.uncertainty_bound == stored["delta_bar"] == 0.3
+    assert np.array_equal(res.sample_values, stored["deltas"]) and res.sample_values.size == 21
+    assert res.worst_value == stored["deltas"][stored["worst_sample"]]
+    assert hn.recertify(path)["ok"]
+    # saved again, the file names them generically and loads the same
+    from hinfnav.papers.sun2011 import save_design
+
+    again = json.loads(save_design(res, tmp_path / "again.json").read_text())["certificate"]
+    assert "delta_bar" not in again and again["uncertainty_bound"] == 0.3 and again["sample_values"] == stored["deltas"]
+    assert np.array_equal(load_design(tmp_path / "again.json").A_F, res.A_F)

@@ -171,6 +171,6 @@ def test_knee_of_a_known_curve():
 def test_bad_gamma(scenario, hinf_opt):
     s = scenario.design_model(DELTA_BAR)
     with pytest.raises(hn.InputError, match="gamma"):
-        synthesize_mixed(s.A, s.B, s.C, s.D, s.L, s.H, s.E, gamma=-1.0, structure="diagonal")
+        synthesize_mixed(s, gamma=-1.0, structure="diagonal")
     with pytest.raises(SynthesisError, match="infeasible"):
         mixed_design_for_scenario(scenario, DELTA_BAR, 0.5 * hinf_opt.gamma, solver="CVXOPT")

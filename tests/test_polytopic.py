@@ -45,7 +45,7 @@ def _rank_one(poly):
 
 
 def test_double_integrator_observer_form_designs_and_certifies():
-    res = hn.synthesize(A_DI, B_DI, C_DI, D_DI, np.eye(4), form="observer", dt=T)
+    res = hn.synthesize(hn.UncertainSystem(A_DI, B_DI, C_DI, D_DI, np.eye(4), dt=T), form="observer")
     assert res.form == "observer" and np.isfinite(res.gamma)
     # the observer structure: A_F = A + B_F C, C_F = −L (to round-off)
     assert np.allclose(res.A_F, A_DI + res.B_F @ C_DI, atol=1e-12) and np.allclose(res.C_F, -np.eye(4))
@@ -57,14 +57,14 @@ def test_double_integrator_observer_form_designs_and_certifies():
 
 def test_marginally_stable_plant_general_form_says_why_and_what_helps():
     with pytest.raises(UnstablePlantError) as exc:
-        hn.synthesize(A_DI, B_DI, C_DI, D_DI, np.eye(4))
+        hn.synthesize(hn.UncertainSystem(A_DI, B_DI, C_DI, D_DI, np.eye(4)))
     msg = str(exc.value)
     assert "ΔA x" in msg and "form='observer'" in msg and "Scenario" not in msg
 
 
 def test_zero_output_is_a_clear_error():
     with pytest.raises(InputError, match=r"\bL\b.*nothing to estimate"):
-        hn.synthesize(A_DI * 0.5, B_DI, C_DI, D_DI, np.zeros((2, 4)))
+        hn.synthesize(hn.UncertainSystem(A_DI * 0.5, B_DI, C_DI, D_DI, np.zeros((2, 4))))
 
 
 def test_observer_form_refuses_uncertainty_that_multiplies_the_state():
@@ -90,7 +90,7 @@ def test_ordering_pdl_quadratic_norm_bounded_at_10pct():
     nb = _rank_one(poly)
     g_pdl = hn.synthesize_polytopic(poly, lyapunov="parameter-dependent")
     g_q = hn.synthesize_polytopic(poly, lyapunov="common")
-    g_nb = hn.synthesize(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E, dt=poly.dt)
+    g_nb = hn.synthesize(hn.UncertainSystem(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E, dt=poly.dt))
     assert "time-varying" in g_q.covers
     assert g_pdl.gamma <= g_q.gamma * (1 + ORDER_RTOL) and g_q.gamma <= g_nb.gamma * (1 + ORDER_RTOL)
     for r in (g_pdl, g_q):
@@ -113,7 +113,7 @@ def test_sun2011_as_a_polytope_beside_corollary1():
 def test_norm_bounded_infeasibility_gives_the_small_gain_number():
     nb = _rank_one(two_mass_spring(0.3, c=0.2))
     with pytest.raises(InfeasibleLMIError, match=r"‖E\(zI − A\)⁻¹H‖∞ = [0-9.]+ ≥ 1.*parameter-dependent"):
-        hn.synthesize(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E, solver="CLARABEL")
+        hn.synthesize(hn.UncertainSystem(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E), solver="CLARABEL")
 
 
 def test_h2_double_integrator_matches_the_kalman_predictor():

@@ -10,6 +10,7 @@ dense grid of the simplex, or why the design does not exist.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -56,7 +57,7 @@ def compare_uncertainty_models(system: PolytopicSystem, *, form: str = "general"
         row = {"model": "norm-bounded (Corollary 1)", "covers": "every time-varying F(k), FᵀF ≤ I",
                "small_gain": small_gain_number(nb.A, nb.H, nb.E)}
         try:
-            r = synthesize(nb.A, nb.B, nb.C, nb.D, nb.L, nb.H, nb.E, dt=system.dt, form=form, solver=solver)
+            r = synthesize(dataclasses.replace(nb, dt=system.dt), form=form, solver=solver)
             worst = np.max(sampled_norms(system, r.A_F, r.B_F, r.C_F, "general", None)[0]) if form == "general" \
                 else r.verified_norm
             rows.append(dict(row, gamma=r.gamma, worst_sampled=float(worst), status="certified"))

@@ -92,6 +92,5 @@ def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | Non
         result = synthesize_polytopic(PolytopicSystem.from_norm_bounded(system), lyapunov=lyapunov, form=form,
                                       solver=solver)
     else:
-        result = synthesize(system.A, system.B, system.C, system.D, system.L, system.H, system.E, dt=system.dt,
-                            form=form, solver=solver, structure="full")
+        result = synthesize(system, form=form, solver=solver, structure="full")
     return result, design_summary(result)

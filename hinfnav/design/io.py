@@ -11,6 +11,11 @@ solver. :func:`load_design` refuses a file whose system does
 not match the one it is loaded for, naming what differs (another T, another
 B …), so a filter is never run on a system it was not designed and certified
 for.
+
+The certificate of a norm-bounded design holds the uncertainty bound and the
+parameter value of each sample as ``uncertainty_bound`` and ``sample_values``;
+files written before version 0.3 name them ``delta_bar`` and ``deltas`` (Sun
+et al. 2011's δ), in the same format ``hinfnav-design/2``, and load the same.
 """
 
 from __future__ import annotations
@@ -107,8 +112,8 @@ def design_to_dict(result, system, *, options=None, extra=None):
     else:
         cert.update(
             method=result.method, structure=result.structure,
-            delta_bar=None if result.delta_bar is None else float(result.delta_bar),
-            deltas=None if result.deltas is None else np.asarray(result.deltas).tolist(),
+            uncertainty_bound=None if result.uncertainty_bound is None else float(result.uncertainty_bound),
+            sample_values=None if result.sample_values is None else np.asarray(result.sample_values).tolist(),
             covers="every time-varying F(k) with FᵀF ≤ I (one quadratic Lyapunov function)"
             if system.H is not None else "the nominal system",
         )
@@ -185,6 +190,9 @@ def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
 def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
     system = UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], mats["H"], mats["E"], float(s["dt"]))
     w = d.get("witness") or {}
+    # files saved before 0.3 name the bound and the sample values after Sun 2011's δ: "delta_bar", "deltas"
+    bound = c.get("uncertainty_bound", c.get("delta_bar"))
+    values = c.get("sample_values", c.get("deltas"))
     variables = {k: (np.asarray(v, dtype=float) if isinstance(v, list) and k != "P" else
                      [np.asarray(P, dtype=float) for P in v] if k == "P" else v) for k, v in w.items()}
     result = SynthesisResult(
@@ -193,8 +201,8 @@ def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
         worst_sample=int(c.get("worst_sample", 0)), spectral_radius=float(c["spectral_radius"]),
         solver=str(c.get("solver")), solve_time_s=float(c.get("solve_time_s", 0.0)),
         total_time_s=float(c.get("total_time_s", 0.0)), method=str(c.get("method")), dt=float(f["dt"]),
-        structure=str(c.get("structure")), delta_bar=c.get("delta_bar"),
-        deltas=None if c.get("deltas") is None else np.asarray(c["deltas"], dtype=float), form=str(c.get("form")),
+        structure=str(c.get("structure")), uncertainty_bound=bound, form=str(c.get("form")),
+        sample_values=None if values is None else np.asarray(values, dtype=float),
         variables=variables, system=system,
     )
     return result, system, d

@@ -65,6 +65,7 @@ from ..lmi.robust_brl import robust_bounded_real_lmi
 from ..lmi.robust_h2 import robust_h2_bound
 from ..lmi.solve import INFEASIBLE, SolverOptions
 from ..systems.uncertain import UncertainSystem
+from .arguments import system_argument
 from .result import SynthesisResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
@@ -280,11 +281,9 @@ class _Check:
 class _Designer:
     """Validated data, samples and compiled problems of one uncertain system (internal)."""
 
-    def __init__(self, A, B, C, D, L, H, E, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov,
-                 options, solver):
+    def __init__(self, system, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov, options, solver):
         self.t_start = time.perf_counter()
-        system = UncertainSystem(A, B, C, D, L, H, E, dt=1.0)
-        self.dt = True if dt is True else as_positive("dt", dt)
+        self.dt = dt
         self.structure = as_choice("structure", structure, ("full", "diagonal"))
         self.lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
         n_random_samples = as_int_at_least("n_random_samples", n_random_samples, 0)
@@ -296,7 +295,7 @@ class _Designer:
             raise InputError(f"options must be a hinfnav.SolverOptions; got {type(options).__name__}")
         self.options = options
         if system.H is not None and not (np.any(system.H) and np.any(system.E)):
-            system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, None, None, 1.0)
+            system = dataclasses.replace(system, H=None, E=None)
         sample_set = uncertainty_samples if isinstance(uncertainty_samples, SampleSet) else None
         if uncertainty_samples is None:
             samples = default_uncertainty_samples(system, self.structure, n_random_samples, seed)
@@ -449,7 +448,7 @@ class _Designer:
             spectral_radius=float(np.max(chk.wc.spectral_radii)), solver=slv, solve_time_s=seconds,
             total_time_s=total, method="h2-minimize", dt=self.dt, variables=chk.variables, attempts=log,
             structure=self.structure, samples=tuple(self.samples),
-            delta_bar=None if ss is None else ss.bound, deltas=None if ss is None else ss.values,
+            uncertainty_bound=None if ss is None else ss.bound, sample_values=None if ss is None else ss.values,
             form="general", sample_labels=() if ss is None else ss.labels,
             h2_bound=float(chk.nu), h2_lmi=float(math.sqrt(max(sol.nu2, 0.0))),
             h2_synthesis_bound=float(chk.nu_synthesis), h2_analysis_bound=float(chk.nu_analysis),
@@ -459,13 +458,11 @@ class _Designer:
 
 
 _DOC_PARAMS = """
-    A, B, C, D, L : array_like
-        The plant ψ_d (9): shapes (n, n), (n, p), (m, n), (m, q), (l, n);
-        A Schur stable for every admissible F.
-    H, E : array_like, optional
-        ``ΔA = H F E``, ``FᵀF ≤ I`` (10)–(11); leave out for a nominal design.
-    dt : float or True, optional
-        Sampling time of :meth:`~SynthesisResult.statespace`.
+    system : UncertainSystem
+        The plant ψ_d (9)–(11) (no H, E: nominal), A Schur stable for every
+        admissible F; its ``dt`` (s) is the result's. Deprecated until 0.3:
+        the loose matrices ``A, B, C, D, L[, H, E]`` with ``dt=``, as in
+        :func:`hinfnav.design.synthesize`.
     structure : {"full", "diagonal"}, optional
         Whether F is any contraction or diagonal (balancing, default samples),
         as in :func:`hinfnav.design.synthesize`.
@@ -484,11 +481,10 @@ _DOC_PARAMS = """
 """
 
 
-def synthesize_mixed(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
-                     E: ArrayLike | None = None, *, gamma: float | None = None, dt: float | bool = True, structure: str = "full",
+def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float | None = None, structure: str = "full",
                      uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                      seed: int | np.random.Generator = 0, lyapunov: str = "extended", options: SolverOptions | None = None,
-                     solver: str | None = None) -> MixedSynthesisResult:
+                     solver: str | None = None, **legacy: Any) -> MixedSynthesisResult:
     """Robust mixed H2/H∞ filter: minimize the certified worst-case H2 norm ν subject to the H∞ bound γ.
 
     Parameters
@@ -520,19 +516,18 @@ def synthesize_mixed(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: 
     with Q = BBᵀ, R = DDᵀ): the filter (12) is a predictor (z_f(k) uses
     y up to k − 1). The test suite checks this to 1e-4.
     """
-    designer = _Designer(A, B, C, D, L, H, E, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov,
-                         options, solver)
+    system, dt = system_argument("synthesize_mixed", system, matrices, legacy)
+    designer = _Designer(system, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov, options, solver)
     res = designer.design(gamma)
     return dataclasses.replace(res, total_time_s=time.perf_counter() - designer.t_start)
 
 
-def mixed_front(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
-                E: ArrayLike | None = None, *, gammas: Sequence[float], include_h2: bool = True, dt: float | bool = True,
+def mixed_front(system: UncertainSystem, *matrices: ArrayLike, gammas: Sequence[float], include_h2: bool = True,
                 structure: str = "full", uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None,
                 n_random_samples: int = 4, seed: int | np.random.Generator = 0, lyapunov: str = "extended",
                 options: SolverOptions | None = None, solver: str | None = None, gamma_star: float | None = None,
                 hinf_result: SynthesisResult | None = None,
-                progress: Callable[[MixedSynthesisResult], object] | None = None) -> MixedFront:
+                progress: Callable[[MixedSynthesisResult], object] | None = None, **legacy: Any) -> MixedFront:
     """Certified mixed designs along a γ grid (one compiled problem, re-solved per γ).
 
     Parameters
@@ -556,8 +551,8 @@ def mixed_front(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: Array
     g = np.sort(np.array([as_positive("gammas entry", v) for v in np.ravel(gammas)], dtype=float))
     if g.size == 0:
         raise InputError("gammas must contain at least one γ")
-    designer = _Designer(A, B, C, D, L, H, E, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov,
-                         options, solver)
+    system, dt = system_argument("mixed_front", system, matrices, legacy)
+    designer = _Designer(system, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov, options, solver)
     results = []
     for gamma in g:
         res = designer.design(float(gamma))

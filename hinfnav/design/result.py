@@ -17,8 +17,6 @@ if TYPE_CHECKING:
 __all__ = ["SynthesisResult"]
 
 
-
-
 @dataclass(frozen=True, eq=False)
 class SynthesisResult:
     """A certified robust H∞ filter (12) from Theorem 1 / Corollary 1.
@@ -67,13 +65,13 @@ class SynthesisResult:
         Uncertainty structure assumed (``"diagonal"`` or ``"full"``).
     samples : tuple
         The uncertainty matrices F that were checked.
-    delta_bar : float or None
-        Bound of the uncertain parameter when the samples came from a
-        :class:`~hinfnav.design.samples.SampleSet` that has one (δ̄ of Sun
-        et al. 2011).
-    deltas : ndarray or None
+    uncertainty_bound : float or None
+        Bound of the scalar parameter the uncertainty stands for, when the
+        samples came from a :class:`~hinfnav.design.samples.SampleSet` that
+        has one (e.g. the bound of a relative parameter error); None otherwise.
+    sample_values : ndarray or None
         The parameter value of each sample (same order as ``sample_norms``),
-        from the sample set.
+        from the sample set; None when the samples carry no values.
     sample_labels : tuple of str
         A label per sample (e.g. ``"δ = 0.05"``).
     form : str
@@ -102,8 +100,8 @@ class SynthesisResult:
     attempts: tuple = ()
     structure: str = "full"
     samples: tuple = ()
-    delta_bar: float = None
-    deltas: np.ndarray = None
+    uncertainty_bound: float = None
+    sample_values: np.ndarray = None
     form: str = "general"
     sample_labels: tuple = ()
     system: object = None
@@ -113,9 +111,9 @@ class SynthesisResult:
         return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
 
     @property
-    def worst_delta(self) -> float | None:
-        """Parameter value (δ) of the worst sample (None when the samples carry no values)."""
-        return None if self.deltas is None else float(self.deltas[self.worst_sample])
+    def worst_value(self) -> float | None:
+        """Parameter value of the worst sample (None when the samples carry no values)."""
+        return None if self.sample_values is None else float(self.sample_values[self.worst_sample])
 
     def error_system(self, system: UncertainSystem, F: ArrayLike | None = None) -> control.StateSpace:
         """Error system (13)–(15) of this filter on ``system`` at uncertainty F."""

@@ -43,7 +43,8 @@ With ``form="observer"`` the filter is constrained to a predictor observer
 is certified with a full Lyapunov matrix for the returned filter.
 
 Nothing here knows about a paper's scenario: the uncertain system comes in as
-matrices, the uncertainty samples as a :class:`~hinfnav.design.SampleSet`.
+an :class:`~hinfnav.systems.UncertainSystem`, the uncertainty samples as a
+:class:`~hinfnav.design.SampleSet`.
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -69,11 +70,12 @@ from ..core.exceptions import (
     SolverAccuracyWarning,
 )
 from ..core.linalg import spectral_radius
-from ..core.validation import as_choice, as_int_at_least, as_positive, as_seed
+from ..core.validation import as_choice, as_int_at_least, as_seed
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..lmi.conditioning import lmi20_diagonal, normalize, prepare
 from ..lmi.solve import INFEASIBLE, SolverOptions, solve_lmi
 from ..systems.uncertain import UncertainSystem
+from .arguments import system_argument
 from .explain import infeasibility_hint
 from .polytopic import observer_nominal
 from .result import SynthesisResult
@@ -196,31 +198,23 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
     return _Check(True, "certified", gamma_c, A_F, B_F, C_F, wc, variables)
 
 
-def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayLike, H: ArrayLike | None = None,
-               E: ArrayLike | None = None, *, dt: float | bool = True, structure: str = "full",
+def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "full",
                uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                seed: int | np.random.Generator = 0, form: str = "general", options: SolverOptions | None = None,
-               solver: str | None = None) -> SynthesisResult:
+               solver: str | None = None, **legacy: Any) -> SynthesisResult:
     """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
 
     Parameters
     ----------
-    A : array_like, shape (n, n)
-        Plant matrix (must be Schur stable for every admissible F).
-    B : array_like, shape (n, p)
-        Process-noise matrix.
-    C : array_like, shape (m, n)
-        Measurement matrix.
-    D : array_like, shape (m, q)
-        Measurement-noise matrix.
-    L : array_like, shape (l, n)
-        Estimated signal ``z = L x``.
-    H, E : array_like, shapes (n, r) and (r, n), optional
-        ``ΔA = H F E`` with ``FᵀF ≤ I`` (10)–(11). Leave out (or give zeros)
-        for the nominal H∞ filter.
-    dt : float or True, optional
-        Sampling time of :meth:`SynthesisResult.statespace` (True: discrete,
-        unspecified).
+    system : UncertainSystem
+        The plant ψ_d (9)–(11): ``x(k+1) = (A + H F E) x(k) + B w(k)``,
+        ``y = C x + D v``, ``z = L x``, ``FᵀF ≤ I`` (no H, E, or zero ones:
+        the nominal H∞ filter). A must be Schur stable for every admissible
+        F. Its ``dt`` (s) is the sampling time of the result's
+        :meth:`SynthesisResult.statespace`. Deprecated until 0.3: the loose
+        matrices ``A, B, C, D, L[, H, E]`` with ``dt=`` (float, or True:
+        discrete, unspecified), with a :class:`DeprecationWarning`
+        (:func:`hinfnav.design.arguments.system_argument`).
     structure : {"full", "diagonal"}, optional
         Whether F is any contraction or diagonal (as in the paper, Section 4);
         decides how H and E are balanced (see :func:`prepare_uncertainty`)
@@ -228,8 +222,9 @@ def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayL
     uncertainty_samples : SampleSet or sequence of array_like, optional
         Contractions F (shape (r, r)) at which the error system is checked;
         default :func:`default_uncertainty_samples`. A :class:`SampleSet`
-        also carries a label per sample and the parameter value behind it
-        (returned as ``deltas``/``delta_bar``).
+        also carries a label per sample and, for a family parametrized by one
+        scalar, the parameter value behind each sample and its bound
+        (returned as ``sample_values`` and ``uncertainty_bound``).
     n_random_samples : int, optional
         Random contractions in the default samples.
     seed : int or numpy.random.Generator, optional
@@ -332,8 +327,7 @@ def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayL
     so that ``x̂ = C_F x_f`` is that estimate, as in the paper (L = I).
     """
     t_start = time.perf_counter()
-    system = UncertainSystem(A, B, C, D, L, H, E, dt=1.0)
-    dt_value = True if dt is True else as_positive("dt", dt)
+    system, dt_value = system_argument("synthesize", system, matrices, legacy)
     structure = as_choice("structure", structure, ("full", "diagonal"))
     n_random_samples = as_int_at_least("n_random_samples", n_random_samples, 0)
     seed = as_seed("seed", seed)
@@ -364,7 +358,7 @@ def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayL
         raise InputError("L is zero: the estimated signal z = L x is identically 0, so there is nothing to estimate "
                          "(the zero filter is exact); give a nonzero L")
     if system.H is not None and not (np.any(system.H) and np.any(system.E)):
-        system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, None, None, 1.0)
+        system = dataclasses.replace(system, H=None, E=None)
     if form == "observer" and system.H is None and not spectral_radius(system.A) < 1.0:
         return observer_nominal(system, dt_value, solvers, t_start)  # needs detectability only (no plant state)
     sample_set = uncertainty_samples if isinstance(uncertainty_samples, SampleSet) else None
@@ -435,11 +429,11 @@ def synthesize(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: ArrayL
             attempts=tuple(run.log),
             structure=structure,
             samples=tuple(checked_samples),
-            delta_bar=None if sample_set is None else sample_set.bound,
-            deltas=None if sample_set is None else sample_set.values,
+            uncertainty_bound=None if sample_set is None else sample_set.bound,
+            sample_values=None if sample_set is None else sample_set.values,
             form=form,
             sample_labels=() if sample_set is None else sample_set.labels,
-            system=dataclasses.replace(system, dt=1.0 if dt_value is True else dt_value),
+            system=system,
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
         hint = infeasibility_hint(system.A, system.H, system.E, structure, form)

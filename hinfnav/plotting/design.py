@@ -136,13 +136,14 @@ def plot_worst_case_over_delta(result: SynthesisResult, *, ax: Axes, label: str 
     -------
     list of matplotlib artists
     """
-    if result.deltas is None:
+    if result.sample_values is None:
         raise InputError("result must come from design_for_scenario (it has no δ grid)")
-    artists = ax.plot(result.deltas, result.sample_norms, "o-", ms=3, label=label or "‖Ψ‖∞ at δ", **line_kw)
+    artists = ax.plot(result.sample_values, result.sample_norms, "o-", ms=3, label=label or "‖Ψ‖∞ at δ", **line_kw)
     color = artists[0].get_color()
     artists.append(ax.axhline(result.gamma, ls="--", color=color, lw=0.8, label=f"certified γ = {result.gamma:.6g}"))
     k = result.worst_sample
-    artists += ax.plot([result.deltas[k]], [result.sample_norms[k]], "k*", ms=9, label=f"worst δ = {result.deltas[k]:.3g}")
+    artists += ax.plot([result.sample_values[k]], [result.sample_norms[k]], "k*", ms=9,
+                       label=f"worst δ = {result.sample_values[k]:.3g}")
     ax.set_xlabel("orbital-rate error δ (–)")
     ax.set_ylabel("‖Ψ‖∞ (m or m/s per unit noise)")
     ax.grid(True, alpha=0.3)

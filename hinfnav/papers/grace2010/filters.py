@@ -46,6 +46,7 @@ from ...systems.hill import (
     uncertainty_F,
     uncertainty_structure,
 )
+from ...systems.uncertain import UncertainSystem
 from .constants import DT_S
 from .dataset import hill_to_inertial, inertial_to_hill
 from .dynamics import MODELS, pair, rk4
@@ -144,10 +145,11 @@ def lmi_designs(omega0, delta_bar, Q, D, *, mixed_factor=2.0):
     deltas = np.array([-delta_bar, 0.0, delta_bar])
     samples = SampleSet(tuple(uncertainty_F(d, delta_bar) for d in deltas), tuple(f"δ = {d:g}" for d in deltas),
                         deltas, delta_bar)
-    common = dict(structure="diagonal", uncertainty_samples=samples, dt=DT_S, options=SolverOptions(polish=False))
+    system = UncertainSystem(A, B, C, D, np.eye(6), DT_S * Ha, Ea, dt=DT_S)
+    common = dict(structure="diagonal", uncertainty_samples=samples, options=SolverOptions(polish=False))
     out = {}
     try:
-        r = _quiet(synthesize, A, B, C, D, np.eye(6), DT_S * Ha, Ea, form="observer", **common)
+        r = _quiet(synthesize, system, form="observer", **common)
         obs = observer_form(r.A_F, r.B_F, r.C_F, A, C)
         out["robust"] = {"result": r, "G": obs["G"], "gamma": r.gamma, "sampled_norm": r.verified_norm,
                          "observer_residual": float(obs["residual"])}
@@ -155,8 +157,7 @@ def lmi_designs(omega0, delta_bar, Q, D, *, mixed_factor=2.0):
         out["robust"] = {"error": f"{type(exc).__name__}: {exc}"}
     if "gamma" in out["robust"]:
         try:
-            m = _quiet(synthesize_mixed, A, B, C, D, np.eye(6), DT_S * Ha, Ea,
-                       gamma=mixed_factor * out["robust"]["gamma"], **common)
+            m = _quiet(synthesize_mixed, system, gamma=mixed_factor * out["robust"]["gamma"], **common)
             obs = observer_form(m.A_F, m.B_F, m.C_F, A, C)
             out["mixed"] = {"result": m, "G": obs["G"], "gamma": m.gamma, "nu": getattr(m, "nu", None),
                             "gamma_bound": mixed_factor * out["robust"]["gamma"],

@@ -75,8 +75,11 @@ def delta_grid(delta_bar, points=21):
     -------
     ndarray, shape (points,) (``[0.]`` when δ̄ = 0)
     """
-    delta_bar = as_nonnegative("delta_bar", delta_bar)
-    points = as_int_at_least("points", points, 2)
+    return _grid(as_nonnegative("delta_bar", delta_bar), as_int_at_least("points", points, 2))
+
+
+def _grid(delta_bar, points):
+    """:func:`delta_grid` of a checked δ̄ and number of points (internal)."""
     if delta_bar == 0:
         return np.zeros(1)
     grid = np.linspace(-delta_bar, delta_bar, points)
@@ -85,9 +88,14 @@ def delta_grid(delta_bar, points=21):
 
 def delta_samples(delta_bar, points=21):
     """The δ grid of :func:`delta_grid` as a :class:`~hinfnav.design.SampleSet` of F_Δa(δ) (None when δ̄ = 0)."""
-    deltas = delta_grid(delta_bar, points)
+    return _samples(as_nonnegative("delta_bar", delta_bar), as_int_at_least("points", points, 2))
+
+
+def _samples(delta_bar, points):
+    """:func:`delta_samples` of a checked δ̄ and number of points (internal)."""
     if delta_bar == 0:
         return None
+    deltas = _grid(delta_bar, points)
     return SampleSet(
         matrices=tuple(uncertainty_F(d, delta_bar) for d in deltas),
         labels=tuple(f"δ = {d:.6g}" for d in deltas),
@@ -103,50 +111,51 @@ def design_for_scenario(scenario: Scenario | None = None, delta_bar: float | Non
     Builds ψ_d from ``scenario.design_model(delta_bar)`` (A = I + T(A₁ + G₀K),
     H = T·H_a, E = E_a of Section 4), treats F as diagonal (the paper's
     F_Δa) and certifies on the δ grid :func:`delta_grid` (vertices ±δ̄ and 0
-    included), with F(δ) from :func:`hinfnav.models.uncertainty_F`.
+    included), with F(δ) from :func:`hinfnav.systems.hill.uncertainty_F`.
 
     Parameters
     ----------
     scenario : Scenario, optional
         Default: the paper's.
     delta_bar : float, optional
-        Default ``scenario.delta_bar``.
+        Default ``scenario.delta_bar``; checked where the system is built
+        (:func:`hinfnav.systems.hill.uncertainty_structure`).
     delta_points : int, optional
         Points of the δ grid.
     **options
-        Passed to :func:`synthesize` (``solver``, ``method``, ``form``, ...).
+        Passed to :func:`synthesize` (``solver``, ``method``, ``form``, ...);
+        ``dt`` (s) replaces the design model's sampling time in the result.
 
     Returns
     -------
     SynthesisResult
-        With ``delta_bar`` and ``deltas`` set, ``dt = scenario.dt``.
+        With ``uncertainty_bound`` = δ̄ and ``sample_values`` = the δ grid,
+        ``dt = scenario.dt``.
     """
-    scenario = Scenario() if scenario is None else scenario
-    if not isinstance(scenario, Scenario):
-        raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
-    delta_bar = scenario.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
+    scenario = _scenario(scenario)
     delta_points = as_int_at_least("delta_points", delta_points, 2)
     check_keywords("design option", options, _SYNTHESIS_OPTIONS)
-    system = scenario.design_model(delta_bar)
-    samples = delta_samples(delta_bar, delta_points)
+    system = scenario.design_model(delta_bar)  # checks δ̄ (once, where H and E are built)
+    delta_bar = float(scenario.delta_bar if delta_bar is None else delta_bar)
+    if "dt" in options:
+        system = dataclasses.replace(system, dt=options.pop("dt"))
+    samples = _samples(delta_bar, delta_points)
     options.setdefault("structure", "diagonal")
-    options.setdefault("dt", scenario.dt)
     try:
-        result = synthesize(
-            system.A, system.B, system.C, system.D, system.L, system.H, system.E, uncertainty_samples=samples, **options
-        )
+        result = synthesize(system, uncertainty_samples=samples, **options)
     except UnstablePlantError as exc:
         if delta_bar > 0 and spectral_radius(system.A) < 1.0:  # stable at δ = 0: it is δ̄ that is too large
             raise UnstablePlantError(f"delta_bar = {delta_bar:g} is too large for this scenario: {exc}") from None
         raise
     if samples is None:
         # a nominal design is checked at δ = 0 only; record it so reports can say so
-        result = _with_grid(result, delta_bar, delta_grid(delta_bar, delta_points))
+        result = with_grid(result, delta_bar, _grid(delta_bar, delta_points))
     return result
 
 
-def _with_grid(result, delta_bar, deltas):
-    return dataclasses.replace(result, delta_bar=float(delta_bar), deltas=np.asarray(deltas, dtype=float))
+def with_grid(result, delta_bar, deltas):
+    """``result`` with the δ̄ and δ grid of a nominal design recorded (it is checked at δ = 0 only)."""
+    return dataclasses.replace(result, uncertainty_bound=float(delta_bar), sample_values=np.asarray(deltas, dtype=float))
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,7 +205,7 @@ class GammaSweep:
                 "gamma": r.gamma,
                 "lmi_gamma": r.lmi_gamma,
                 "verified_norm": r.verified_norm,
-                "worst_delta": r.worst_delta,
+                "worst_delta": r.worst_value,
                 "solver": r.solver,
                 "method": r.method,
                 "solve_time_s": r.solve_time_s,
@@ -263,13 +272,13 @@ def design_report(delta_bar: float, solver: str | None = None, scenario: Scenari
 def design_report_from(res):
     """The JSON-ready report of :func:`design_report` for a design already made (with provenance)."""
     return {
-        "delta_bar": float(res.delta_bar),
+        "delta_bar": float(res.uncertainty_bound),
         "form": res.form,
         "gamma": res.gamma,
         "lmi_gamma": res.lmi_gamma,
         "lmi20_gamma": float(res.variables.get("lmi20_gamma", res.gamma)),
         "verified_norm": res.verified_norm,
-        "worst_delta": res.worst_delta,
+        "worst_delta": res.worst_value,
         "spectral_radius": res.spectral_radius,
         "solver": res.solver,
         "method": res.method,
@@ -279,7 +288,7 @@ def design_report_from(res):
         "A_F": res.A_F.tolist(),
         "B_F": res.B_F.tolist(),
         "C_F": res.C_F.tolist(),
-        "deltas_checked": [float(d) for d in res.deltas],
+        "deltas_checked": [float(d) for d in res.sample_values],
         "attempts": list(res.attempts),
         "provenance": provenance(),
     }
@@ -433,9 +442,9 @@ def _scenario(scenario):
 def _is_scenario_design(result):
     """Whether a result was made by :func:`design_for_scenario` (its system is the paper's design model)."""
     own = result.system
-    if getattr(result, "delta_bar", None) is None or not hasattr(own, "A"):
+    if getattr(result, "uncertainty_bound", None) is None or not hasattr(own, "A"):
         return False
-    ref = Scenario().design_model(float(result.delta_bar))
+    ref = Scenario().design_model(float(result.uncertainty_bound))
     return own.A.shape == ref.A.shape and np.allclose(own.A, ref.A) and np.allclose(own.B, ref.B)
 
 
@@ -455,7 +464,7 @@ def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLi
         raise InputError(f"result must be a hinfnav SynthesisResult (from design_for_scenario); got {type(result).__name__}")
     scenario = _scenario(scenario)
     design_io.check_design_path(path)
-    delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
+    delta_bar = 0.0 if result.uncertainty_bound is None else float(result.uncertainty_bound)
     system = scenario.design_model(delta_bar)
     options = {"delta_bar": delta_bar, "form": result.form, "structure": result.structure, "solver": result.solver}
     extra = {"paper": "sun2011", "scenario": {"dt_s": scenario.dt, "omega0": scenario.omega0, "mass": scenario.mass}}
@@ -478,7 +487,7 @@ def load_design(path: str | os.PathLike[str], scenario: Scenario | None = None) 
     if not isinstance(result, SynthesisResult):
         raise InputError(f"design file {path} was made for another system (a polytope of "
                          f"{getattr(system, 'n_vertices', '?')} vertices), not for the scenario: design again for it")
-    delta_bar = 0.0 if result.delta_bar is None else float(result.delta_bar)
+    delta_bar = 0.0 if result.uncertainty_bound is None else float(result.uncertainty_bound)
     design_io.check_design_system(system, system.dt, scenario.design_model(delta_bar), scenario.dt,
                                   what="the scenario")
     return result

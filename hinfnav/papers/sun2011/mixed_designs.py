@@ -31,11 +31,11 @@ from tqdm import tqdm
 
 from ...analysis.error_system import error_system_matrices
 from ...core.exceptions import InputError
-from ...core.validation import as_int_at_least, as_nonnegative, as_positive
+from ...core.validation import as_int_at_least, as_positive
 from ...design.mixed import front_gammas, knee_index, mixed_front, synthesize_mixed
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
-from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from
+from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from, with_grid
 from .scenario import Scenario
 
 if TYPE_CHECKING:
@@ -49,17 +49,18 @@ def _setup(scenario, delta_bar, delta_points, options):
     scenario = Scenario() if scenario is None else scenario
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
-    delta_bar = scenario.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
     delta_points = as_int_at_least("delta_points", delta_points, 2)
+    system = scenario.design_model(delta_bar)  # checks δ̄ (once, where H and E are built)
+    delta_bar = float(scenario.delta_bar if delta_bar is None else delta_bar)
+    if "dt" in options:
+        system = dataclasses.replace(system, dt=options.pop("dt"))
     options.setdefault("structure", "diagonal")
-    options.setdefault("dt", scenario.dt)
-    return scenario, delta_bar, scenario.design_model(delta_bar), delta_samples(delta_bar, delta_points)
+    return scenario, delta_bar, system, delta_samples(delta_bar, delta_points)
 
 
 def _with_grid(result, delta_bar, delta_points):
     # a nominal design is checked at δ = 0 only; record it so that reports can say so
-    return dataclasses.replace(result, delta_bar=float(delta_bar),
-                               deltas=np.asarray(delta_grid(delta_bar, delta_points), dtype=float))
+    return with_grid(result, delta_bar, delta_grid(delta_bar, delta_points))
 
 
 def mixed_design_for_scenario(scenario: Scenario | None = None, delta_bar: float | None = None,
@@ -91,8 +92,7 @@ def mixed_design_for_scenario(scenario: Scenario | None = None, delta_bar: float
         Its ``gamma`` the smaller of the synthesis and :func:`analysis_gamma` certificates.
     """
     scenario, delta_bar, system, samples = _setup(scenario, delta_bar, delta_points, options)
-    res = synthesize_mixed(system.A, system.B, system.C, system.D, system.L, system.H, system.E, gamma=gamma,
-                           uncertainty_samples=samples, **options)
+    res = synthesize_mixed(system, gamma=gamma, uncertainty_samples=samples, **options)
     res = _with_grid(res, delta_bar, delta_points) if samples is None else res
     return _recertified(system, res)  # γ certified as every row of a front (certify_front)
 
@@ -198,8 +198,7 @@ def mixed_front_for_scenario(scenario=None, delta_bar=None, *, points=12, span=1
     gammas = front_gammas(hinf_result.gamma, points, span, first)
     with tqdm(total=len(gammas) + 1, disable=not progress, desc=f"H2/H∞ front, δ̄ = {delta_bar:g}",
               unit="design") as bar:
-        front = mixed_front(system.A, system.B, system.C, system.D, system.L, system.H, system.E, gammas=gammas,
-                            uncertainty_samples=samples, gamma_star=hinf_result.gamma, hinf_result=hinf_result,
+        front = mixed_front(system, gammas=gammas, uncertainty_samples=samples, gamma_star=hinf_result.gamma, hinf_result=hinf_result,
                             progress=lambda _res: bar.update(1), **options)
     if samples is None:
         front = dataclasses.replace(

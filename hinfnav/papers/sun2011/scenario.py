@@ -188,13 +188,10 @@ class Scenario:
         -------
         UncertainSystem
         """
-        delta_bar = self.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
+        Ha, Ea = uncertainty_structure(self.omega0, self.delta_bar if delta_bar is None else delta_bar)  # checks δ̄
         A1, G0 = hill_matrices(self.omega0, self.mass)
         A = np.eye(6) + self.dt * (A1 + G0 @ self.K)
-        H = E = None
-        if delta_bar > 0:
-            Ha, Ea = uncertainty_structure(self.omega0, delta_bar)
-            H, E = self.dt * Ha, Ea
+        H, E = (self.dt * Ha, Ea) if np.any(Ea) else (None, None)  # δ̄ = 0: nominal
         return UncertainSystem(A, self.B, measurement_matrix(), self.D, self.L, H, E, self.dt)
 
     def design_A(self, delta: float = 0.0) -> NDArray[np.float64]:

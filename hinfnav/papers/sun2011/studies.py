@@ -203,7 +203,7 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
     pub = published_filter()
     filters = {"published": (pub.A_F, pub.B_F, pub.C_F), "re-synthesized": (design.A_F, design.B_F, design.C_F)}
     if observer is True:
-        db = delta_bar if getattr(design, "delta_bar", None) is None else design.delta_bar
+        db = delta_bar if getattr(design, "uncertainty_bound", None) is None else design.uncertainty_bound
         observer = design_for_scenario(scenario, db, form="observer")
     if observer is not None and observer is not False:
         filters["observer form"] = (observer.A_F, observer.B_F, observer.C_F)

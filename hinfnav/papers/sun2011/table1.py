@@ -25,7 +25,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...core.validation import as_int_at_least, as_nonnegative, as_seed
+from ...core.validation import as_int_at_least, as_seed
 from ...core.progress import bar_disabled
 from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
@@ -211,7 +211,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
     as_seed("seed", seed)
-    delta_bar = scenario.delta_bar if delta_bar is None else as_nonnegative("delta_bar", delta_bar)
+    delta_bar = scenario.delta_bar if delta_bar is None else delta_bar  # checked by design_for_scenario
     for key, f in (("designed", designed), ("observer", observer)):
         if f is not None and not isinstance(f, SynthesisResult):
             raise InputError(f"{key} must be a hinfnav SynthesisResult (from design_for_scenario); got {type(f).__name__}")
@@ -219,7 +219,7 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
         designed = design_for_scenario(scenario, delta_bar=delta_bar)
     if observer is None:
         observer = design_for_scenario(scenario, delta_bar=delta_bar, form="observer")
-    bounds = {k: float(delta_bar if getattr(f, "delta_bar", None) is None else f.delta_bar)
+    bounds = {k: float(delta_bar if getattr(f, "uncertainty_bound", None) is None else f.uncertainty_bound)
               for k, f in (("hinf_designed", designed), ("hinf_observer", observer))}
     win = scenario.rms_window_s
     cells, ekf_windows, klim = {}, {}, {}
