@@ -22,6 +22,7 @@ name                       estimator
 
 from __future__ import annotations
 
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -37,7 +38,8 @@ from .scenario import Scenario
 if TYPE_CHECKING:
     from ...estimators.base import Estimator
 
-__all__ = ["FILTER_NAMES", "VERBATIM", "make_estimator", "lti_from_matrices"]
+__all__ = ["FILTER_NAMES", "VERBATIM", "BUILDERS", "make_estimator", "build_published", "build_designed",
+           "lti_from_matrices"]
 
 FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                 "designed_observer_closed_loop", "ekf", "ekf_known_input")
@@ -84,36 +86,59 @@ def make_estimator(name: str, scenario: Scenario, **options: Any) -> Estimator:
     Parameters
     ----------
     name : str
+        One of :data:`FILTER_NAMES`; each has its own builder, with the
+        variant's settings bound (:data:`BUILDERS`).
     scenario : Scenario
     **options
         Passed to the estimator's builder (for ``designed``: options of
         :func:`hinfnav.synthesize`; for the EKFs: see :mod:`hinfnav.papers.sun2011.ekf`).
     """
+    _check_scenario(scenario)
+    return BUILDERS[as_choice("filter", name, FILTER_NAMES)](scenario, **options)
+
+
+def _check_scenario(scenario):
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
-    as_choice("filter", name, FILTER_NAMES)
-    if name in ("published", "published_closed_loop"):
-        if options:
-            raise InputError(f"filter {name!r} is the printed filter and takes no options; got {', '.join(sorted(options))}")
-        pub = published_filter()
-        return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=(name == "published"),
-                                 design_dt=pub.dt)
-    if name.startswith("designed"):
-        n = scenario.x0.size
-        if scenario.L.shape != (n, n) or not np.linalg.cond(scenario.L) < 1e12:
-            raise InputError(
-                f"filter {name!r} estimates the whole state (x̂ = C_F x_f), so the scenario's L must be square and "
-                f"invertible; got L of shape {scenario.L.shape[0]}x{scenario.L.shape[1]}"
-                + ("" if scenario.L.shape != (n, n) else f" with condition number {np.linalg.cond(scenario.L):.3g}")
-                + " (design_for_scenario designs for any L)"
-            )
-        if name.startswith("designed_observer"):
-            options.setdefault("form", "observer")
-        res = design_for_scenario(scenario, **options)
-        return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=name not in VERBATIM,
-                                 design_dt=res.dt)
-    return build_ekf(scenario, known_input=(name == "ekf_known_input"), **options)
 
+
+def build_published(scenario: Scenario, *, name: str, uses_input: bool, **options: Any) -> Estimator:
+    """The printed filter (δ̄ = 0.05) as estimator ``name``; told the thrust when ``uses_input``."""
+    _check_scenario(scenario)
+    if options:
+        raise InputError(f"filter {name!r} is the printed filter and takes no options; got {', '.join(sorted(options))}")
+    pub = published_filter()
+    return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=uses_input, design_dt=pub.dt)
+
+
+def build_designed(scenario: Scenario, *, name: str, uses_input: bool, **options: Any) -> Estimator:
+    """The filter of :func:`design_for_scenario` (``options``, e.g. ``form``) as estimator ``name``."""
+    _check_scenario(scenario)
+    n = scenario.x0.size
+    if scenario.L.shape != (n, n) or not np.linalg.cond(scenario.L) < 1e12:
+        raise InputError(
+            f"filter {name!r} estimates the whole state (x̂ = C_F x_f), so the scenario's L must be square and "
+            f"invertible; got L of shape {scenario.L.shape[0]}x{scenario.L.shape[1]}"
+            + ("" if scenario.L.shape != (n, n) else f" with condition number {np.linalg.cond(scenario.L):.3g}")
+            + " (design_for_scenario designs for any L)"
+        )
+    res = design_for_scenario(scenario, **options)
+    return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=uses_input, design_dt=res.dt)
+
+
+#: Each registered name's builder, with the variant's settings bound (its name, whether it is told the
+#: applied thrust, the filter form, whether the EKF knows the input); the options a caller gives are added.
+BUILDERS = {
+    "published": partial(build_published, name="published", uses_input=True),
+    "published_closed_loop": partial(build_published, name="published_closed_loop", uses_input=False),
+    "designed": partial(build_designed, name="designed", uses_input=True),
+    "designed_closed_loop": partial(build_designed, name="designed_closed_loop", uses_input=False),
+    "designed_observer": partial(build_designed, name="designed_observer", uses_input=True, form="observer"),
+    "designed_observer_closed_loop": partial(build_designed, name="designed_observer_closed_loop", uses_input=False,
+                                             form="observer"),
+    "ekf": partial(build_ekf, known_input=False),
+    "ekf_known_input": partial(build_ekf, known_input=True),
+}
 
 _DESCRIPTIONS = {
     "published": "Sun 2011's printed H-inf filter (delta_bar = 0.05), told the applied thrust",
@@ -131,13 +156,5 @@ def _fits(scenario):
     return isinstance(scenario, Scenario)
 
 
-def _builder(name):
-    def build(scenario, **options):
-        return make_estimator(name, scenario, **options)
-
-    build.__name__ = f"build_{name}"
-    return build
-
-
 for _name in FILTER_NAMES:
-    register_estimator(_name, _builder(_name), fits=_fits, description=_DESCRIPTIONS[_name])
+    register_estimator(_name, BUILDERS[_name], fits=_fits, description=_DESCRIPTIONS[_name])
