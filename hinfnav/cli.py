@@ -1,36 +1,106 @@
 """Command line: ``python -m hinfnav {simulate,design,reproduce,campaign} ...``.
 
 Run ``python -m hinfnav COMMAND --help`` for each command's options. The
-parser imports nothing heavy: each command imports the layers it needs when it
-runs, so ``--help`` starts fast. The choices below are literals for that reason;
-``tests/test_cli.py`` checks that they equal the package's own lists.
+parser imports nothing heavy: the choices of ``--filter``, ``--noise``,
+``--solver`` and ``--paper`` are read from the package's own registries and
+lists (:class:`RegistryChoices`) the first time they are needed (a value to
+check, or a command's ``--help``), and each command imports the layers it
+needs when it runs, so ``python -m hinfnav --help`` starts fast.
 """
 
 import argparse
+import importlib
 import json
 import math
 import os
 import sys
+from collections.abc import Callable, Sequence
 
 from .core.exceptions import HinfnavError, InputError
 from .core.outputs import check_output_dir
 from .core.validation import check_new_file
 
-__all__ = ["main", "simulate_report", "format_simulate_report", "FILTER_CHOICES", "NOISE_CHOICES", "SOLVER_CHOICES",
-           "PAPER_CHOICES", "MAX_RUNS"]
+__all__ = ["main", "simulate_report", "format_simulate_report", "RegistryChoices", "FILTER_CHOICES",
+           "NOISE_CHOICES", "SOLVER_CHOICES", "PAPER_CHOICES", "MAX_RUNS"]
 
-#: ``simulate --filter`` choices: every registered estimator that fits Sun 2011's scenario (tested).
-FILTER_CHOICES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
-                  "designed_observer_closed_loop", "ekf", "ekf_known_input", "recursive_hinf", "hbf", "ukf",
-                  "ekf_augmented_thrust", "ekf_augmented_thrust_st", "ekf_augmented_thrust_adaptive")
-#: ``--noise`` choices (= hinfnav.noise.NOISE_NAMES).
-NOISE_CHOICES = ("gaussian", "colored", "mixture", "uniform", "laplace", "student_t")
-#: ``design --solver`` choices (= hinfnav.lmi.SOLVERS).
-SOLVER_CHOICES = ("CLARABEL", "CVXOPT", "SCS")
+
+class RegistryChoices(Sequence):
+    """The choices of an option, read from the package when first used (a sequence of names).
+
+    Parameters
+    ----------
+    load : callable
+        ``load() -> sequence of str``, called once, on the first membership
+        test, iteration or length (argparse checks a value by ``in`` and
+        lists the choices in ``--help`` and its errors by iterating).
+    what : str
+        What the names are (for ``repr``).
+    """
+
+    def __init__(self, load: Callable[[], Sequence[str]], what: str):
+        self._load, self._what, self._names = load, what, None
+
+    def _items(self):
+        if self._names is None:
+            self._names = tuple(self._load())
+        return self._names
+
+    def __getitem__(self, index):
+        return self._items()[index]
+
+    def __len__(self):
+        return len(self._items())
+
+    def __contains__(self, value):
+        return value in self._items()
+
+    def __iter__(self):
+        return iter(self._items())
+
+    def __repr__(self):
+        return f"RegistryChoices({self._what}: {', '.join(self._items())})"
+
+
+def _attribute(module, name):
+    """``load`` of a :class:`RegistryChoices`: attribute ``name`` of ``module`` (imported then)."""
+    return lambda: getattr(importlib.import_module(module), name)
+
+
+def _lazy(action, choices):
+    """Give ``action`` its :class:`RegistryChoices` after ``add_argument``.
+
+    ``add_argument`` formats the option once to check it, which would read the
+    registry while the parser is built (and ``python -m hinfnav --help`` would
+    import every layer); set afterwards, the choices are read only to check a
+    value or to print that command's ``--help``.
+    """
+    action.choices = choices
+    return action
+
+
+def _sun2011_estimators():
+    from .estimators.registry import registered_estimators
+    from .papers.sun2011.scenario import Scenario
+
+    return registered_estimators(Scenario())
+
+
+def _paper_keys():
+    from .papers import PAPERS, SELECTIONS
+
+    return tuple(SELECTIONS) + tuple(PAPERS)
+
+
+#: ``simulate --filter`` choices: every registered estimator that fits Sun 2011's scenario.
+FILTER_CHOICES = RegistryChoices(_sun2011_estimators, "estimators registered for Sun 2011's scenario")
+#: ``--noise`` choices: hinfnav.noise.NOISE_NAMES.
+NOISE_CHOICES = RegistryChoices(_attribute("hinfnav.noise", "NOISE_NAMES"), "noise models")
+#: ``design --solver`` choices: hinfnav.lmi.solve.SOLVERS.
+SOLVER_CHOICES = RegistryChoices(_attribute("hinfnav.lmi.solve", "SOLVERS"), "SDP solvers")
 #: Largest ``--runs`` (= hinfnav.papers.sun2011.report.MAX_RUNS), checked before anything heavy is imported.
 MAX_RUNS = 1_000_000
-#: ``reproduce --paper`` choices (= the selections and keys of hinfnav.papers: tested).
-PAPER_CHOICES = ("papers", "all", "sun2011", "shi2018", "attitude2018", "yang2020", "grace2010", "benchmark")
+#: ``reproduce --paper`` choices: the selections and keys of hinfnav.papers.
+PAPER_CHOICES = RegistryChoices(_paper_keys, "paper selections and keys")
 
 
 def simulate_report(*args, **kwargs):
@@ -173,7 +243,7 @@ def _parser():
     sub.required = True
 
     s = sub.add_parser("simulate", help="simulate the paper's scenario with one filter and print its errors")
-    s.add_argument("--filter", default="published", choices=FILTER_CHOICES, help="estimator (default: published)")
+    _lazy(s.add_argument("--filter", default="published", help="estimator (default: published)"), FILTER_CHOICES)
     s.add_argument("--design", metavar="FILE", default=None,
                    help="run a filter saved by 'design --save FILE' instead of --filter (refused if made for another "
                         "system, e.g. another T)")
@@ -181,7 +251,7 @@ def _parser():
                    help="with --design: run (12) exactly, assuming u = Kx (default: told the applied thrust)")
     s.add_argument("--no-maneuver", action="store_true", help="free motion, u = 0 (default: maneuver, u = Kx)")
     s.add_argument("--delta", type=float, default=0.0, help="true orbital-rate error delta, omega = omega0(1+delta) (default 0)")
-    s.add_argument("--noise", default="gaussian", choices=NOISE_CHOICES, help="noise model of w and v (default gaussian)")
+    _lazy(s.add_argument("--noise", default="gaussian", help="noise model of w and v (default gaussian)"), NOISE_CHOICES)
     s.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     s.add_argument("--runs", type=int, default=1, help="Monte Carlo runs (default 1; memory does not grow with runs)")
     s.add_argument("--discretization", default="exact", choices=("exact", "euler"), help="truth discretization (default exact)")
@@ -190,8 +260,9 @@ def _parser():
 
     d = sub.add_parser("design", help="design a robust H-infinity filter by LMI (Corollary 1) and certify it")
     d.add_argument("--delta-bar", type=float, default=0.05, help="uncertainty bound delta_bar >= 0 (default 0.05)")
-    d.add_argument("--solver", default=None, type=str.upper, choices=SOLVER_CHOICES,
-                   help="SDP solver (default: CLARABEL, polished by CVXOPT; SCS is slow and loose, with a warning)")
+    _lazy(d.add_argument("--solver", default=None, type=str.upper,
+                         help="SDP solver (default: CLARABEL, polished by CVXOPT; SCS is slow and loose, with a "
+                              "warning)"), SOLVER_CHOICES)
     d.add_argument("--form", default="general", choices=("general", "observer"),
                    help="filter structure: general (the paper's LMI (20), default) or observer "
                         "(extension: error independent of the trajectory)")
@@ -215,9 +286,9 @@ def _parser():
     d.set_defaults(func=_cmd_design)
 
     r = sub.add_parser("reproduce", help="regenerate a paper's tables and figures into a folder (Table 1, Figs 2-7)")
-    r.add_argument("--paper", default="papers", choices=PAPER_CHOICES,
-                   help="which paper (default: papers = the four papers; all adds the cross-paper benchmark; "
-                        "sun2011 writes into --out itself, the others into --out/<paper>/)")
+    _lazy(r.add_argument("--paper", default="papers",
+                         help="which paper (default: papers = the four papers; all adds the cross-paper benchmark; "
+                              "sun2011 writes into --out itself, the others into --out/<paper>/)"), PAPER_CHOICES)
     r.add_argument("--out", default="results", help="output folder (default: results/)")
     r.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     r.add_argument("--runs", type=int, default=None,

@@ -20,6 +20,45 @@ def test_help_lists_the_commands():
         assert cmd in out.stdout
 
 
+def _option(parser, command, flag):
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    return next(a for a in sub._actions if flag in a.option_strings)
+
+
+def test_cli_choices_are_read_from_the_registries():
+    # issue 23: the options' choices are the package's registries and lists (not re-typed), and each command
+    # accepts exactly those names (argparse checks by the same object), with the options' spelling unchanged
+    from hinfnav.cli import _parser
+    from hinfnav.estimators.registry import registered_estimators
+    from hinfnav.lmi.solve import SOLVERS
+    from hinfnav.noise import NOISE_NAMES
+    from hinfnav.papers import PAPERS, SELECTIONS
+    from hinfnav.papers.sun2011 import FILTER_NAMES, Scenario
+
+    parser = _parser()
+    expected = {
+        ("simulate", "--filter"): registered_estimators(Scenario()),
+        ("simulate", "--noise"): NOISE_NAMES,
+        ("design", "--solver"): SOLVERS,
+        ("reproduce", "--paper"): tuple(SELECTIONS) + tuple(PAPERS),
+    }
+    for (command, flag), names in expected.items():
+        assert tuple(_option(parser, command, flag).choices) == tuple(names), (command, flag)
+    assert set(FILTER_NAMES) < set(expected["simulate", "--filter"])  # Sun's own and the other papers' that fit
+    for name in expected["simulate", "--filter"]:
+        assert parser.parse_args(["simulate", "--filter", name]).filter == name
+    with pytest.raises(SystemExit):
+        parser.parse_args(["simulate", "--filter", "designed_observer_x"])
+
+
+def test_building_the_parser_reads_no_registry():
+    # `python -m hinfnav --help` stays fast: the registries are read when a value is checked, not before
+    code = ("import sys; from hinfnav.cli import _parser; _parser(); "
+            "print([m for m in ('hinfnav.papers', 'hinfnav.lmi.solve', 'hinfnav.noise', 'cvxpy') if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stdout + out.stderr
+
+
 def test_reproduce_takes_a_paper(capsys):
     with pytest.raises(SystemExit):
         main(["reproduce", "--help"])

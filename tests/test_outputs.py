@@ -42,11 +42,11 @@ def test_cli_choices_are_the_packages_own_lists():
 
     assert set(FILTER_NAMES) <= set(FILTER_CHOICES)
     assert set(FILTER_CHOICES) == set(registered_estimators(hn.Scenario()))
-    assert NOISE_CHOICES == NOISE_NAMES
-    assert SOLVER_CHOICES == SOLVERS
+    assert tuple(NOISE_CHOICES) == NOISE_NAMES
+    assert tuple(SOLVER_CHOICES) == SOLVERS
     from hinfnav.papers import SELECTIONS
 
-    assert PAPER_CHOICES == tuple(SELECTIONS) + tuple(PAPERS)
+    assert tuple(PAPER_CHOICES) == tuple(SELECTIONS) + tuple(PAPERS)
 
 
 def test_design_save_then_simulate_and_refusal_at_another_T(tmp_path, capsys):
