@@ -29,7 +29,7 @@ def main(argv=None):
     print(f"scenario: {s.n_steps} steps of T = {s.dt} s, {args.runs} runs")
     rows = []
     for name in ("published", "ekf", "ekf_known_input"):
-        est = hn.make_estimator(name, s)
+        est = hn.make_estimator(s, name)
         vec = _time(lambda: hn.simulate(s, est, runs=args.runs, seed=0, batch_size=args.runs), repeat=2)
         loop = _time(lambda: hn.simulate(s, est, runs=min(args.runs, 10), seed=0, batch_size=1), repeat=1)
         loop *= args.runs / min(args.runs, 10)
@@ -42,7 +42,7 @@ def main(argv=None):
     print(f"truth alone: {truth:.2f} s for {args.runs} runs ({1e3 * truth / args.runs:.1f} ms per run)")
     # the step contract: the LTI filter's vectorized estimate against the generic step loop
     tr = hn.simulate_truth(model, runs=args.runs, seed=0)
-    est = hn.make_estimator("published", s)
+    est = hn.make_estimator(s, "published")
     fast = _time(lambda: est.estimate(tr.y, tr.u, s.xhat0), repeat=2)
     loop = _time(lambda: hn.Estimator.estimate(est, tr.y, tr.u, s.xhat0), repeat=1)
     print(f"LTI filter, {args.runs} runs: vectorized estimate {fast:.2f} s, generic step loop {loop:.2f} s "

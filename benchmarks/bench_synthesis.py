@@ -27,7 +27,7 @@ def run(solver, repeat, form="general"):
     best = None
     for _ in range(repeat):
         t0 = time.perf_counter()
-        sweep = gamma_sweep(DEFAULT_DELTA_BARS, Scenario(), solver=solver, form=form)
+        sweep = gamma_sweep(Scenario(), DEFAULT_DELTA_BARS, solver=solver, form=form)
         wall = time.perf_counter() - t0
         if best is None or wall < best[0]:
             best = (wall, sweep)

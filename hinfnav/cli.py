@@ -189,7 +189,7 @@ def _cmd_design_h2(args, save_design):
         raise InputError("--objective h2 designs general-form filters only; leave out --form observer")
     if args.points < 2:
         raise InputError(f"--points must be >= 2; got {args.points}")
-    rep, result = mixed_design_report(args.delta_bar, gamma=args.gamma, solver=args.solver, points=args.points)
+    rep, result = mixed_design_report(None, args.delta_bar, gamma=args.gamma, solver=args.solver, points=args.points)
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
     print(json.dumps(rep, indent=2) if args.json else format_mixed_design_report(rep))

@@ -137,8 +137,8 @@ API_ROWS = [
                                                              rms_window_s=(0, 2)), "ekf"), r"\bD\b"),
     _row("D-singular-kalman-limit", lambda c: hn.kalman_limit(hn.Scenario(D=np.diag([0.1, 0.1, 0.0]))), r"\bD\b"),
     # was: "C_F must be invertible" (C_F is the designed filter's; the user gave L)
-    _row("L-singular-designed", lambda c: sun.make_estimator("designed", hn.Scenario(L=np.zeros((6, 6)))), r"\bL\b"),
-    _row("L-3x6-designed", lambda c: sun.make_estimator("designed", hn.Scenario(L=np.eye(3, 6))), r"\bL\b"),
+    _row("L-singular-designed", lambda c: sun.make_estimator(hn.Scenario(L=np.zeros((6, 6))), "designed"), r"\bL\b"),
+    _row("L-3x6-designed", lambda c: sun.make_estimator(hn.Scenario(L=np.eye(3, 6)), "designed"), r"\bL\b"),
     _row("L-singular-observer", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, np.zeros((2, 2))), form="observer"), r"\bL\b"),
     # -- noise ---------------------------------------------------------------------------------------------
     _row("noise-name", lambda c: hn.simulate(SHORT, "published", noise="pink"), r"\bnoise\b"),
@@ -159,9 +159,9 @@ API_ROWS = [
     _row("filter-unknown", lambda c: hn.simulate(SHORT, "kalmann"), r"\bfilter\b"),
     _row("estimator-int", lambda c: hn.simulate(SHORT, 3), r"\bestimator\b"),
     # was: TypeError EKF() got an unexpected keyword argument
-    _row("ekf-option-unknown", lambda c: sun.make_estimator("ekf", SHORT, foo=1), r"\bfoo\b"),
+    _row("ekf-option-unknown", lambda c: sun.make_estimator(SHORT, "ekf", foo=1), r"\bfoo\b"),
     # was: accepted and silently ignored
-    _row("published-option", lambda c: sun.make_estimator("published", SHORT, delta_bar=0.3), r"\bdelta_bar\b"),
+    _row("published-option", lambda c: sun.make_estimator(SHORT, "published", delta_bar=0.3), r"\bdelta_bar\b"),
     # was: TypeError unhashable type
     _row("build_estimator-list", lambda c: hn.build_estimator(["ekf"], SHORT), r"\bfilter\b"),
     # was: accepted, failing later with TypeError
@@ -190,8 +190,8 @@ API_ROWS = [
     _row("design-delta_bar-1e200", lambda c: sun.design_for_scenario(None, 1e200), r"\bdelta_bar\b"),
     _row("design-delta_bar-1e9", lambda c: sun.design_for_scenario(None, 1e9), r"\bdelta_bar\b", UnstablePlantError),
     # was: an empty sweep returned
-    _row("gamma-sweep-empty", lambda c: hn.gamma_sweep([]), r"\bdelta_bars\b"),
-    _row("gamma-sweep-scalar", lambda c: hn.gamma_sweep(0.05), r"\bdelta_bars\b"),
+    _row("gamma-sweep-empty", lambda c: hn.gamma_sweep(None, []), r"\bdelta_bars\b"),
+    _row("gamma-sweep-scalar", lambda c: hn.gamma_sweep(None, 0.05), r"\bdelta_bars\b"),
     # was: LinAlgError Singular matrix
     _row("observer-form-C_F-singular", lambda c: hn.observer_form(0.5 * np.eye(2), np.eye(2, 1), np.zeros((2, 2)),
                                                                   0.5 * np.eye(2), np.eye(1, 2)), r"\bC_F\b"),

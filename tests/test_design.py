@@ -175,7 +175,7 @@ def test_solvers_agree_and_gamma_nondecreasing(paper_design, scenario):
     clar = design_for_scenario(sc, 0.05, solver="CLARABEL")
     assert clar.gamma == pytest.approx(paper_design.gamma, rel=1e-4)
     assert clar.solver == "CLARABEL"
-    sweep = gamma_sweep([0.0, 0.05, 1.0], sc)
+    sweep = gamma_sweep(sc, [0.0, 0.05, 1.0])
     assert sweep.nondecreasing
     g0, g05, g1 = sweep.gammas
     assert g0 < g05 < g1
@@ -187,7 +187,7 @@ def test_solvers_agree_and_gamma_nondecreasing(paper_design, scenario):
 
 
 def test_design_report_is_json_ready():
-    rep = design_report(0.01)
+    rep = design_report(None, 0.01)
     text = json.dumps(rep)
     back = json.loads(text)
     for key in ("delta_bar", "gamma", "lmi_gamma", "solver", "solve_time_s", "A_F", "B_F", "C_F", "verified_norm", "worst_delta"):
@@ -438,8 +438,8 @@ def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_desig
     # vs 0.3585922), at δ̄ = 1 the restriction costs 0.5 % in LMI (20) (measured 0.361529 vs 0.359641) but
     # only 0.0007 % with a full Lyapunov matrix for the observer filter (measured 0.359644, the reported γ)
     sc = scenario
-    general = gamma_sweep([0.0, 1.0], sc)
-    observer = gamma_sweep([0.0, 1.0], sc, form="observer")
+    general = gamma_sweep(sc, [0.0, 1.0])
+    observer = gamma_sweep(sc, [0.0, 1.0], form="observer")
     assert all(r.form == "observer" for r in observer.results)
     for g, o in zip(general.gammas, observer.gammas):
         assert o >= g * (1 - 1e-6)
@@ -479,7 +479,7 @@ def test_observer_form_error_does_not_depend_on_the_trajectory(paper_design, obs
     # (transient of the plant state: velocity ~0.4 m/s); without maneuver (told u = 0) the general optimum's
     # velocity error is ~10–22 m/s, the observer's stays below 0.05 m/s (stationary 0.024 m/s of
     # e⁺ = (I + T A₁ − G C) e + …, plus the decay of the initial 30–40 m estimate error)
-    rows = simulation_comparison(paper_design, scenario, runs=10, seed=0, observer=observer_design, starts=("paper",))
+    rows = simulation_comparison(scenario, paper_design, runs=10, seed=0, observer=observer_design, starts=("paper",))
     get = {(r["maneuver"], r["filter"]): r for r in rows}
     assert {f for _, f in get} == {"published", "re-synthesized", "observer form"}
     obs_m = get[True, "observer form"]
@@ -494,7 +494,7 @@ def test_observer_form_error_does_not_depend_on_the_trajectory(paper_design, obs
 
 
 def test_observer_design_report_and_infeasibility():
-    rep = design_report(0.01, form="observer")
+    rep = design_report(None, 0.01, form="observer")
     assert rep["form"] == "observer"
     assert "observer (C_F = −L" in format_design_report(rep)
     # the infeasible scalar example of test_infeasible_lmi_carries_solver_status stays infeasible, and says

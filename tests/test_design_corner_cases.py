@@ -148,7 +148,7 @@ def test_observer_gamma_is_the_full_lyapunov_level(scenario):
 def test_printed_factors_small_gain_crosses_one_between_1_5_and_2(scenario):
     # LMI (20) with the printed H, E and one λ needs ‖E(zI − A)⁻¹H‖∞ < 1 (small gain); it reaches 1 at
     # δ̄ ≈ 1.806, where structure="full" turns infeasible, while the channel-balanced number stays below 0.05
-    sg = small_gain_bounds([1.5, 2.0], scenario)
+    sg = small_gain_bounds(scenario, [1.5, 2.0])
     assert sg["printed"][0] < 1.0 < sg["printed"][1]
     assert np.all(sg["balanced"] < 0.05)
     np.testing.assert_allclose(sg["printed"], [0.764073, 1.164278], rtol=1e-5)  # measured (SLICOT)

@@ -82,7 +82,7 @@ def test_saturated_measurement_clips_and_flags():
 
 def test_closed_loop_on_the_true_state_equals_the_open_loop_truth():
     sc = Scenario(duration_s=50.0, rms_window_s=(10.0, 50.0))
-    est = make_estimator("ekf_known_input", sc)
+    est = make_estimator(sc, "ekf_known_input")
     closed = simulate_closed_loop(sc, est, sc.controller(True, source="truth"), runs=3, seed=5)
     opened = run_estimator(est, simulate_truth(sc.truth_model(maneuver=True), runs=3, seed=5), sc.xhat0)
     # x(k+1) = Φx + Γ(Kx) + Bw against (Φ + ΓK)x + Bw: the same up to round-off
@@ -95,7 +95,7 @@ def test_closed_loop_on_the_estimate_converges_like_the_ideal_loop():
     # 0.02 m/s per axis): the maneuver from 1.3 km must still converge, and the noise-driven
     # range after it stays of the same size as with u = K x on the same noise
     sc = Scenario(duration_s=1500.0, rms_window_s=(100.0, 1500.0))
-    est = make_estimator("ekf_known_input", sc)
+    est = make_estimator(sc, "ekf_known_input")
     ms = {}
     for source in ("truth", "estimate"):
         res = simulate_closed_loop(sc, est, LinearFeedback(sc.K, source=source), runs=20, seed=1)

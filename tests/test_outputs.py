@@ -61,7 +61,7 @@ def test_design_save_then_simulate_and_refusal_at_another_T(tmp_path, capsys):
     d = hn.load_design(path)
     assert d.gamma == saved["gamma"]
     with pytest.raises(hn.InputError, match="T = 0.1 s"):
-        hn.load_design(path, hn.Scenario(dt=1.0))
+        hn.load_design(path, scenario=hn.Scenario(dt=1.0))
     edited = json.loads(path.read_text())
     edited["system"]["B"][0][0] *= 2
     path.write_text(json.dumps(edited))

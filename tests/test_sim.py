@@ -87,7 +87,7 @@ def test_vectorized_monte_carlo_equals_loop(short_scenario):
     np.testing.assert_allclose(vec.x, loop.x, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(vec.xhat, loop.xhat, rtol=1e-12, atol=1e-9)
     # and the filter run on each run's measurements separately
-    est = make_estimator("published", s)
+    est = make_estimator(s, "published")
     for r in range(6):
         one = est.estimate(vec.y[r : r + 1], vec.u[r : r + 1], s.xhat0)
         np.testing.assert_allclose(one.xhat[0], vec.xhat[r], rtol=1e-12, atol=1e-9)

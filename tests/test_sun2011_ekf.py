@@ -217,14 +217,14 @@ def test_keep_covariance_and_diagnostics(short_scenario):
 
 def test_registry_and_simulate(short_scenario):
     sc = short_scenario
-    ekf = make_estimator("ekf", sc)
-    known = make_estimator("ekf_known_input", sc)
+    ekf = make_estimator(sc, "ekf")
+    known = make_estimator(sc, "ekf_known_input")
     assert (ekf.name, ekf.uses_input, ekf.vectorized) == ("ekf", False, True)
     assert (known.name, known.uses_input, known.vectorized) == ("ekf_known_input", True, True)
     res = simulate(sc, ekf, maneuver=False, runs=2, seed=0)
     assert res.xhat.shape == (2, sc.n_steps + 1, 6)
     assert res.P.shape == (2, sc.n_steps + 1, 6, 6)
-    again = simulate(sc, make_estimator("ekf", sc), maneuver=False, runs=2, seed=0)
+    again = simulate(sc, make_estimator(sc, "ekf"), maneuver=False, runs=2, seed=0)
     np.testing.assert_array_equal(res.xhat, again.xhat)
 
 

@@ -73,7 +73,7 @@ def test_lti_error_covariance_published_filter(scenario, assert_rms_matches):
     # state quoted in hinfnav/metrics.py (paper's Table 1 H∞: 0.2 m, 0.8 m/s);
     # cross-checked here against a 30-run Monte Carlo within 4 standard errors
     pub = published_filter()
-    cov = lti_error_covariance(pub.A_F, pub.B_F, pub.C_F, scenario)
+    cov = lti_error_covariance(scenario, pub.A_F, pub.B_F, pub.C_F)
     sd = np.sqrt(np.diag(cov))
     np.testing.assert_allclose(sd[:3], 0.18, atol=0.005)
     np.testing.assert_allclose(sd[3:], 0.80, atol=0.01)
@@ -85,16 +85,16 @@ def test_lti_error_covariance_published_filter(scenario, assert_rms_matches):
 def test_lti_error_covariance_input_correction_and_errors(scenario):
     pub = published_filter()
     G, K = scenario.input_matrix_design(), scenario.K
-    cov = lti_error_covariance(pub.A_F, pub.B_F, pub.C_F, scenario, input_matrix=G, K=K)
+    cov = lti_error_covariance(scenario, pub.A_F, pub.B_F, pub.C_F, input_matrix=G, K=K)
     assert np.all(np.linalg.eigvalsh(cov) > 0)
     with pytest.raises(UnstablePlantError, match="not Schur stable"):
-        lti_error_covariance(pub.A_F, pub.B_F, pub.C_F, scenario, maneuver=False)
+        lti_error_covariance(scenario, pub.A_F, pub.B_F, pub.C_F, maneuver=False)
     with pytest.raises(InputError, match="together"):
-        lti_error_covariance(pub.A_F, pub.B_F, pub.C_F, scenario, input_matrix=G)
+        lti_error_covariance(scenario, pub.A_F, pub.B_F, pub.C_F, input_matrix=G)
     with pytest.raises(InputError, match="B_F must have shape 6x3"):
-        lti_error_covariance(pub.A_F, pub.B_F[:, :2], pub.C_F, scenario)
+        lti_error_covariance(scenario, pub.A_F, pub.B_F[:, :2], pub.C_F)
     with pytest.raises(InputError, match="A_F .*Schur stable"):
-        lti_error_covariance(2 * np.eye(6), pub.B_F, pub.C_F, scenario)
+        lti_error_covariance(scenario, 2 * np.eye(6), pub.B_F, pub.C_F)
 
 
 @pytest.mark.parametrize(

@@ -212,7 +212,7 @@ def chaser_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, progress=Fa
     if scenario.duration_s < WINDOWS[-1][1]:
         raise InputError(f"the chaser study needs duration_s >= {WINDOWS[-1][1]} s; got {scenario.duration_s}")
     truth = simulate_truth(scenario.truth_model(maneuver=True), runs=runs, seed=seed)
-    filters = {"ekf": make_estimator("ekf", scenario), "ekf_known_input": make_estimator("ekf_known_input", scenario)}
+    filters = {"ekf": make_estimator(scenario, "ekf"), "ekf_known_input": make_estimator(scenario, "ekf_known_input")}
     for v in VARIANTS:
         est = build_augmented_thrust(scenario, v)
         filters[est.name] = est

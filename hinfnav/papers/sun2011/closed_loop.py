@@ -97,11 +97,11 @@ def closed_loop_study(scenario=None, *, runs=20, seed=0, noise="gaussian", desig
     if designed is None:
         designed = design_for_scenario(scenario, form="observer")
     estimators = {
-        "truth": make_estimator("published", scenario),
-        "published": make_estimator("published", scenario),
-        "designed_observer": lti_from_matrices(designed.A_F, designed.B_F, designed.C_F, scenario,
+        "truth": make_estimator(scenario, "published"),
+        "published": make_estimator(scenario, "published"),
+        "designed_observer": lti_from_matrices(scenario, designed.A_F, designed.B_F, designed.C_F,
                                                name="designed_observer"),
-        "ekf_known_input": make_estimator("ekf_known_input", scenario),
+        "ekf_known_input": make_estimator(scenario, "ekf_known_input"),
     }
     rows, results = [], {}
     for key, est in estimators.items():

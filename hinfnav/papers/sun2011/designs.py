@@ -37,6 +37,7 @@ from ...design.samples import SampleSet
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
 from ...systems.hill import uncertainty_F
+from .arguments import scenario_first, scenario_keyword
 from .constants import DEFAULT_DELTA_BARS, published_filter
 from .scenario import Scenario
 
@@ -214,15 +215,17 @@ class GammaSweep:
         ]
 
 
-def gamma_sweep(delta_bars: Sequence[float] = DEFAULT_DELTA_BARS, scenario: Scenario | None = None,
+@scenario_first("delta_bars", "scenario", "progress")
+def gamma_sweep(scenario: Scenario | None = None, delta_bars: Sequence[float] = DEFAULT_DELTA_BARS,
                 progress: bool = False, **options: Any) -> GammaSweep:
     """Certified designs for several δ̄ (Corollary 1 at each).
 
     Parameters
     ----------
+    scenario : Scenario, optional
+        Default: the paper's.
     delta_bars : sequence of float, optional
         Default :data:`DEFAULT_DELTA_BARS` (0 … 5).
-    scenario : Scenario, optional
     progress : bool, optional
         Show a tqdm progress bar.
     **options
@@ -244,17 +247,19 @@ def gamma_sweep(delta_bars: Sequence[float] = DEFAULT_DELTA_BARS, scenario: Scen
     return GammaSweep(dbs, tuple(results))
 
 
-def design_report(delta_bar: float, solver: str | None = None, scenario: Scenario | None = None,
+@scenario_first("delta_bar", "solver", "scenario", "form")
+def design_report(scenario: Scenario | None = None, delta_bar: float | None = None, solver: str | None = None,
                   form: str = "general") -> dict[str, Any]:
     """JSON-ready summary of one certified design (for ``python -m hinfnav design``).
 
     Parameters
     ----------
-    delta_bar : float
-        Uncertainty bound δ̄ ≥ 0.
+    scenario : Scenario, optional
+        Default: the paper's.
+    delta_bar : float, optional
+        Uncertainty bound δ̄ ≥ 0; default ``scenario.delta_bar``.
     solver : str, optional
         ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: Clarabel, CVXOPT fallback).
-    scenario : Scenario, optional
     form : {"general", "observer"}, optional
         Filter structure (see :func:`synthesize`).
 
@@ -448,7 +453,8 @@ def _is_scenario_design(result):
     return own.A.shape == ref.A.shape and np.allclose(own.A, ref.A) and np.allclose(own.B, ref.B)
 
 
-def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLike[str],
+@scenario_keyword("result", "path", "scenario")
+def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLike[str], *,
                 scenario: Scenario | None = None) -> Path:
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
 
@@ -471,7 +477,8 @@ def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLi
     return design_io.save_design(result, system, path, options=options, extra=extra)
 
 
-def load_design(path: str | os.PathLike[str], scenario: Scenario | None = None) -> SynthesisResult:
+@scenario_keyword("path", "scenario")
+def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = None) -> SynthesisResult:
     """Load a design file and check it was made for ``scenario`` (default the paper's).
 
     Raises
@@ -493,7 +500,8 @@ def load_design(path: str | os.PathLike[str], scenario: Scenario | None = None) 
     return result
 
 
-def small_gain_bounds(delta_bars, scenario=None):
+@scenario_first("delta_bars", "scenario", scenario=None)
+def small_gain_bounds(scenario, delta_bars):
     """The small-gain number ``‖E(zI − A)⁻¹H‖∞`` of the design model across δ̄.
 
     With one multiplier λ (Lemma 2), the γ-free part of LMI (20) asks the
@@ -508,9 +516,10 @@ def small_gain_bounds(delta_bars, scenario=None):
 
     Parameters
     ----------
+    scenario : Scenario or None
+        None: the paper's.
     delta_bars : sequence of float
         Uncertainty bounds δ̄ > 0.
-    scenario : Scenario, optional
 
     Returns
     -------
@@ -538,5 +547,5 @@ def small_gain_crossing(scenario=None, bracket=(0.5, 5.0)):
     Root of ``small_gain_bounds([δ̄])["printed"] − 1`` by Brent's method in
     ``bracket`` (to 1e-6 in δ̄).
     """
-    f = lambda d: small_gain_bounds([d], scenario)["printed"][0] - 1.0
+    f = lambda d: small_gain_bounds(scenario, [d])["printed"][0] - 1.0
     return float(scipy.optimize.brentq(f, *bracket, xtol=1e-6))

@@ -109,7 +109,7 @@ def paper_runs(scenario=None, *, seed=0, progress=False):
     for maneuver in (False, True):
         truth = simulate_truth(scenario.truth_model(maneuver=maneuver), runs=1, seed=seed)
         for key, name in (("ekf", "ekf"), ("ekf_known_input", "ekf_known_input"), ("hinf_published", "published")):
-            out[(key, maneuver)] = run_estimator(make_estimator(name, scenario), truth, scenario.xhat0)
+            out[(key, maneuver)] = run_estimator(make_estimator(scenario, name), truth, scenario.xhat0)
     return out
 
 

@@ -30,6 +30,7 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
 from ...estimators.registry import register_estimator
+from .arguments import scenario_first
 from .constants import published_filter
 from .designs import design_for_scenario
 from .ekf import build_ekf
@@ -48,15 +49,16 @@ FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_clos
 VERBATIM = ("published_closed_loop", "designed_closed_loop", "designed_observer_closed_loop")
 
 
-def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True, design_dt=None):
+@scenario_first("A_F", "B_F", "C_F", "scenario")
+def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):
     """Wrap filter matrices designed on ``scenario``'s closed loop as an estimator.
 
     Parameters
     ----------
-    A_F, B_F, C_F : array_like
-        Filter (12).
     scenario : Scenario
         Gives T, K and the design model's input matrix T G₀.
+    A_F, B_F, C_F : array_like
+        Filter (12).
     name : str
     uses_input : bool
         Tell the filter the applied thrust (the default); False runs (12)
@@ -80,15 +82,16 @@ def lti_from_matrices(A_F, B_F, C_F, scenario, *, name, uses_input=True, design_
     return scenario.lti_filter(A_F, B_F, C_F, name=name, uses_input=uses_input, design_dt=design_dt)
 
 
-def make_estimator(name: str, scenario: Scenario, **options: Any) -> Estimator:
+@scenario_first("name", "scenario")
+def make_estimator(scenario: Scenario, name: str, **options: Any) -> Estimator:
     """Build an estimator by name (see the module table).
 
     Parameters
     ----------
+    scenario : Scenario
     name : str
         One of :data:`FILTER_NAMES`; each has its own builder, with the
         variant's settings bound (:data:`BUILDERS`).
-    scenario : Scenario
     **options
         Passed to the estimator's builder (for ``designed``: options of
         :func:`hinfnav.synthesize`; for the EKFs: see :mod:`hinfnav.papers.sun2011.ekf`).
@@ -108,7 +111,7 @@ def build_published(scenario: Scenario, *, name: str, uses_input: bool, **option
     if options:
         raise InputError(f"filter {name!r} is the printed filter and takes no options; got {', '.join(sorted(options))}")
     pub = published_filter()
-    return lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name=name, uses_input=uses_input, design_dt=pub.dt)
+    return lti_from_matrices(scenario, pub.A_F, pub.B_F, pub.C_F, name=name, uses_input=uses_input, design_dt=pub.dt)
 
 
 def build_designed(scenario: Scenario, *, name: str, uses_input: bool, **options: Any) -> Estimator:
@@ -123,7 +126,7 @@ def build_designed(scenario: Scenario, *, name: str, uses_input: bool, **options
             + " (design_for_scenario designs for any L)"
         )
     res = design_for_scenario(scenario, **options)
-    return lti_from_matrices(res.A_F, res.B_F, res.C_F, scenario, name=name, uses_input=uses_input, design_dt=res.dt)
+    return lti_from_matrices(scenario, res.A_F, res.B_F, res.C_F, name=name, uses_input=uses_input, design_dt=res.dt)
 
 
 #: Each registered name's builder, with the variant's settings bound (its name, whether it is told the

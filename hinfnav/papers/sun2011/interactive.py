@@ -116,10 +116,10 @@ def interactive_design_view(delta_bar=0.05, noise="gaussian", filter_name="desig
         raise InputError(f"t_from must be below the scenario's duration {scenario.duration_s:g} s; got {t_from:g}")
     design = _design(delta_bar)
     if filter_name == "designed":
-        estimator = lti_from_matrices(design.A_F, design.B_F, design.C_F, scenario, name="designed",
+        estimator = lti_from_matrices(scenario, design.A_F, design.B_F, design.C_F, name="designed",
                                       design_dt=design.dt)
     else:
-        estimator = make_estimator(filter_name, scenario)
+        estimator = make_estimator(scenario, filter_name)
     result = simulate(scenario, estimator, maneuver=True, delta=delta_bar, noise=noise, runs=1, seed=seed)
     rms_pos, rms_vel = pos_vel(rms_per_run(result.error, result.t, (t_from, result.t[-1]))[0], result.state)
     title = (f"{filter_name} filter, δ = δ̄ = {delta_bar:g}, {noise} noise, with maneuver (seed {seed}): "

@@ -43,6 +43,7 @@ from ...analysis.riccati import stationary_lti_error_covariance, steady_state_ka
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_matrix, as_real
 from ...systems.hill import measurement_matrix
+from .arguments import scenario_first
 from .scenario import Scenario
 
 __all__ = ["KalmanLimit", "kalman_limit", "lti_error_covariance"]
@@ -156,8 +157,9 @@ def kalman_limit(scenario: Scenario, maneuver: bool = True, discretization: str 
     )
 
 
+@scenario_first("A_F", "B_F", "C_F", "scenario")
 def lti_error_covariance(
-    A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, scenario: Scenario, *, maneuver: bool = True,
+    scenario: Scenario, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, *, maneuver: bool = True,
     input_matrix: ArrayLike | None = None, K: ArrayLike | None = None, delta: float = 0.0, discretization: str = "exact"
 ) -> NDArray[np.float64]:
     """Stationary error covariance of the LTI filter (12) on the closed loop.
@@ -171,12 +173,12 @@ def lti_error_covariance(
 
     Parameters
     ----------
+    scenario : Scenario
+        Gives B, D, K, T, ω₀ and the mass.
     A_F : array_like, shape (6, 6)
     B_F : array_like, shape (6, 3)
     C_F : array_like, shape (6, 6)
         The filter (12); C_F invertible.
-    scenario : Scenario, optional
-        The paper's by default (B, D, K, T, ω₀, mass).
     maneuver : bool
         Truth with u = K x (True) or u = 0 (False).
     input_matrix : array_like, shape (6, 3), optional

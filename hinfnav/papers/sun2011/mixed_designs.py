@@ -35,6 +35,7 @@ from ...core.validation import as_int_at_least, as_positive
 from ...design.mixed import front_gammas, knee_index, mixed_front, synthesize_mixed
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
+from .arguments import scenario_first
 from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from, with_grid
 from .scenario import Scenario
 
@@ -218,18 +219,21 @@ def _h2_fields(res):
     }
 
 
-def mixed_design_report(delta_bar, gamma=None, solver=None, scenario=None, points=12):
+@scenario_first("delta_bar", "gamma", "solver", "scenario", "points")
+def mixed_design_report(scenario=None, delta_bar=None, gamma=None, solver=None, points=12):
     """JSON-ready summary of a mixed design, or of the front and its knee.
 
     Parameters
     ----------
-    delta_bar : float
+    scenario : Scenario, optional
+        Default: the paper's.
+    delta_bar : float, optional
+        Default ``scenario.delta_bar``.
     gamma : float or None
         With a γ: one mixed design at that H∞ bound. Without: the front
         (:func:`mixed_front_for_scenario`) and its knee.
     solver : str, optional
         One solver (default: CVXOPT, then Clarabel).
-    scenario : Scenario, optional
     points : int, optional
         Points of the front (without ``gamma``).
 

@@ -105,9 +105,9 @@ def _cell(res, t, window, state):
     return axes_rms(state.select(rms, "position")), axes_rms(state.select(rms, "velocity"))
 
 
-def _stationary(A_F, B_F, C_F, scenario):
+def _stationary(scenario, A_F, B_F, C_F):
     try:
-        std = np.sqrt(np.diag(lti_error_covariance(A_F, B_F, C_F, scenario, maneuver=True)))
+        std = np.sqrt(np.diag(lti_error_covariance(scenario, A_F, B_F, C_F, maneuver=True)))
     except (InputError, UnstablePlantError):
         return float("nan"), float("nan")
     return axes_rms(std[:3]), axes_rms(std[3:])
@@ -166,9 +166,9 @@ def pareto_study(scenario=None, delta_bars=(0.05, 1.0), *, points=12, runs=10, s
                 A_F, B_F, C_F = res.A_F, res.B_F, res.C_F
                 cells = {}
                 for maneuver, truth in truths.items():
-                    est = lti_from_matrices(A_F, B_F, C_F, scenario, name=kind, uses_input=not maneuver)
+                    est = lti_from_matrices(scenario, A_F, B_F, C_F, name=kind, uses_input=not maneuver)
                     cells[maneuver] = _cell(run_estimator(est, truth, scenario.xhat0), truth.t, win, truth.state)
-                pos_s, vel_s = _stationary(A_F, B_F, C_F, scenario)
+                pos_s, vel_s = _stationary(scenario, A_F, B_F, C_F)
                 gamma = getattr(res, "gamma", None)
                 if kind == "published":
                     gamma = float("nan")

@@ -68,13 +68,13 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
     if runs > MAX_RUNS:
         raise InputError(f"runs must be at most {MAX_RUNS}; got {runs}")
     if design is not None:
-        result = design if not isinstance(design, (str, bytes)) and hasattr(design, "A_F") else load_design(design, scenario)
+        result = design if not isinstance(design, (str, bytes)) and hasattr(design, "A_F") else load_design(design, scenario=scenario)
         est = scenario.estimator_from_design(result, verbatim=verbatim, name="design")
         label = "design" + (" (verbatim)" if verbatim else "")
     else:
         if verbatim:
             raise InputError("verbatim applies to --design only (the registered names say how each filter runs)")
-        est = make_estimator(filter, scenario) if filter in FILTER_NAMES else build_estimator(filter, scenario)
+        est = make_estimator(scenario, filter) if filter in FILTER_NAMES else build_estimator(filter, scenario)
         label = filter
     win = scenario.rms_window_s
     stats = monte_carlo_statistics(scenario, est, windows={"main": win}, runs=runs, seed=seed, noise=noise,

@@ -17,6 +17,7 @@ from ...metrics.errors import axes_rms, max_error, rms_error, rms_per_run
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth
 from .constants import published_filter
+from .arguments import scenario_first
 from .designs import design_for_scenario
 from .filters import lti_from_matrices
 from .limits import lti_error_covariance
@@ -83,7 +84,8 @@ def sweep_result(sweep, delta_bar):
     return sweep.results[int(matches[0])]
 
 
-def stationary_std(A_F, B_F, C_F, scenario, *, maneuver=True, discretization="euler"):
+@scenario_first("A_F", "B_F", "C_F", "scenario")
+def stationary_std(scenario, A_F, B_F, C_F, *, maneuver=True, discretization="euler"):
     """Noise-only stationary per-axis standard deviations (position m, velocity m/s) of a filter.
 
     With maneuver: the filter run verbatim as (12) on the closed loop
@@ -93,7 +95,7 @@ def stationary_std(A_F, B_F, C_F, scenario, *, maneuver=True, discretization="eu
     depends on the drifting plant state.
     """
     if maneuver:
-        std = np.sqrt(np.diag(lti_error_covariance(A_F, B_F, C_F, scenario, discretization=discretization)))
+        std = np.sqrt(np.diag(lti_error_covariance(scenario, A_F, B_F, C_F, discretization=discretization)))
         return std[:3], std[3:]
     design_A = scenario.design_model(0.0).A
     C = scenario.design_model(0.0).C
@@ -143,7 +145,8 @@ def format_robustness_table(rows):
     return "\n".join(lines)
 
 
-def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest"),
+@scenario_first("design", "scenario", "runs", "seed")
+def simulation_comparison(scenario=None, design=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest"),
                           delta_bar=None):
     """Monte Carlo RMS errors of the published and the re-synthesized filters.
 
@@ -157,10 +160,11 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
 
     Parameters
     ----------
+    scenario : Scenario, optional
+        Default: the paper's.
     design : SynthesisResult, optional
         The general (LMI (20)) design; default :func:`design_for_scenario`
         at ``delta_bar``.
-    scenario : Scenario, optional
     runs : int, optional
         Monte Carlo runs per case.
     seed : int, optional
@@ -210,14 +214,14 @@ def simulation_comparison(design=None, scenario=None, runs=20, seed=0, *, observ
     stationary = {}
     for name, (A_F, B_F, C_F) in filters.items():
         for maneuver in (True, False):
-            stationary[name, maneuver] = stationary_std(A_F, B_F, C_F, scenario, maneuver=maneuver)
+            stationary[name, maneuver] = stationary_std(scenario, A_F, B_F, C_F, maneuver=maneuver)
     rows = []
     for start in starts:
         sc = scenario if start == "paper" else scenario.replace(x0=np.zeros(6), xhat0=np.zeros(6))
         for maneuver in (True, False):
             truth = simulate_truth(sc.truth_model(maneuver=maneuver), runs=runs, seed=seed)
             for name, (A_F, B_F, C_F) in filters.items():
-                est = lti_from_matrices(A_F, B_F, C_F, sc, name=name, uses_input=not maneuver)
+                est = lti_from_matrices(sc, A_F, B_F, C_F, name=name, uses_input=not maneuver)
                 res = run_estimator(est, truth, sc.xhat0)
                 pos, vel = pos_vel(rms_error(res.error, res.t, sc.rms_window_s), res.state)
                 rows.append(

@@ -65,15 +65,15 @@ def _estimators(scenario, designed, maneuver, observer=None):
     pub = published_filter()
     told = not maneuver
     est = {
-        "ekf": make_estimator("ekf", scenario),
-        "ekf_known_input": make_estimator("ekf_known_input", scenario),
-        "hinf_published": lti_from_matrices(pub.A_F, pub.B_F, pub.C_F, scenario, name="published", uses_input=told),
+        "ekf": make_estimator(scenario, "ekf"),
+        "ekf_known_input": make_estimator(scenario, "ekf_known_input"),
+        "hinf_published": lti_from_matrices(scenario, pub.A_F, pub.B_F, pub.C_F, name="published", uses_input=told),
     }
     if designed is not None:
-        est["hinf_designed"] = lti_from_matrices(designed.A_F, designed.B_F, designed.C_F, scenario, name="designed",
+        est["hinf_designed"] = lti_from_matrices(scenario, designed.A_F, designed.B_F, designed.C_F, name="designed",
                                                  uses_input=told)
     if observer is not None:
-        est["hinf_observer"] = lti_from_matrices(observer.A_F, observer.B_F, observer.C_F, scenario,
+        est["hinf_observer"] = lti_from_matrices(scenario, observer.A_F, observer.B_F, observer.C_F,
                                                  name="designed_observer", uses_input=told)
     return est
 
