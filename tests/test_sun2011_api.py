@@ -57,3 +57,23 @@ def test_the_earlier_argument_order_still_works_with_a_warning():
         make_estimator("ekf", sc, "extra")
     with pytest.raises(TypeError, match="multiple values for argument 'scenario'"):
         make_estimator("ekf", sc, scenario=sc)
+
+
+def test_synthesis_result_old_attribute_names_warn_and_agree():
+    """``delta_bar``/``deltas``/``worst_delta`` (before issue 23) map to the generic names, with a warning."""
+    import warnings
+
+    from hinfnav.design.result import _RENAMED, SynthesisResult
+
+    res = SynthesisResult(A_F=np.eye(1), B_F=np.eye(1), C_F=np.eye(1), gamma=1.0, lmi_gamma=1.0, verified_norm=1.0,
+                          sample_norms=np.array([0.5, 1.0]), worst_sample=1, spectral_radius=0.5, solver="x",
+                          solve_time_s=0.0, total_time_s=0.0, method="minimize", uncertainty_bound=0.3,
+                          sample_values=np.array([-0.3, 0.3]))
+    for old, new in _RENAMED.items():
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            value = getattr(res, old)
+        assert np.array_equal(value, getattr(res, new))  # the same object's value: exact
+        assert any(issubclass(w.category, DeprecationWarning) and new in str(w.message) for w in caught)
+    with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
+        res.nonsense  # noqa: B018
