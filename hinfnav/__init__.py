@@ -18,7 +18,7 @@ command line starts fast.
 
 import importlib
 
-from .core.provenance import package_version
+from .io.provenance import package_version
 
 #: Public name -> the module (relative to this package) it comes from.
 _EXPORTS = {

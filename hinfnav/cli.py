@@ -13,7 +13,7 @@ import os
 import sys
 
 from .core.exceptions import HinfnavError, InputError
-from .core.outputs import check_output_dir
+from .io.outputs import check_output_dir
 from .core.validation import check_new_file
 
 __all__ = ["main", "simulate_report", "format_simulate_report", "FILTER_CHOICES", "NOISE_CHOICES", "SOLVER_CHOICES",

@@ -16,7 +16,7 @@ import pytest
 
 import hinfnav as hn
 from hinfnav.cli import FILTER_CHOICES, NOISE_CHOICES, PAPER_CHOICES, SOLVER_CHOICES, main
-from hinfnav.core.outputs import MARKER, atomic_output_dir, check_output_dir
+from hinfnav.io.outputs import MARKER, atomic_output_dir, check_output_dir
 
 REPRO = [sys.executable, "-m", "hinfnav", "reproduce", "--paper", "sun2011", "--runs", "2"]
 

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
-from ..core.progress import bar_disabled
+from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
 from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator

@@ -21,7 +21,7 @@ from pathlib import Path
 import filelock
 import numpy as np
 
-from .exceptions import InputError
+from ..core.exceptions import InputError
 
 __all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "write_json"]
 
