@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 
 from .core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .core import (
         CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
         UnstablePlantError,
@@ -65,77 +65,6 @@ if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS 
     )
     from .campaign import Campaign, load_campaign, read_campaign, run_campaign
 
-#: Public name -> the module it comes from, imported on first use.
-_EXPORTS = {
-    "CertificationError": ".core",
-    "HinfnavError": ".core",
-    "InfeasibleLMIError": ".core",
-    "InputError": ".core",
-    "SynthesisError": ".core",
-    "UnstablePlantError": ".core",
-    "discretize": ".core",
-    "PolytopicSystem": ".systems",
-    "two_mass_spring": ".systems",
-    "LinearMeasurement": ".systems",
-    "LinearSystem": ".systems",
-    "MeasurementModel": ".systems",
-    "RangeAzimuthElevation": ".systems",
-    "Saturated": ".systems",
-    "StateSpec": ".systems",
-    "UncertainSystem": ".systems",
-    "hill_matrices": ".systems",
-    "position_from_range_angles": ".systems",
-    "range_angles": ".systems",
-    "uncertainty_F": ".systems",
-    "uncertainty_structure": ".systems",
-    "NOISE_NAMES": ".noise",
-    "make_noise": ".noise",
-    "h2_norm": ".analysis",
-    "hinf_norm": ".analysis",
-    "observer_form": ".analysis",
-    "steady_state_hinf": ".analysis",
-    "steady_state_kalman": ".analysis",
-    "truncated_normal_moments": ".analysis",
-    "worst_case_norm": ".analysis",
-    "SampleSet": ".design",
-    "SolverOptions": ".design",
-    "SynthesisResult": ".design",
-    "PolytopicResult": ".design",
-    "synthesize_polytopic": ".design",
-    "recertify": ".design",
-    "synthesize": ".design",
-    "synthesize_mixed": ".design",
-    "MixedSynthesisResult": ".design",
-    "HuberFilter": ".estimators",
-    "RecursiveHInfinityFilter": ".estimators",
-    "EstimateHistory": ".estimators",
-    "Estimator": ".estimators",
-    "ExtendedKalmanFilter": ".estimators",
-    "FilterState": ".estimators",
-    "LTIFilter": ".estimators",
-    "StepOutput": ".estimators",
-    "build_estimator": ".estimators",
-    "huber_update": ".estimators",
-    "register_estimator": ".estimators",
-    "registered_estimators": ".estimators",
-    "LinearFeedback": ".control",
-    "SimulationResult": ".sim",
-    "TruthModel": ".sim",
-    "simulate": ".sim",
-    "simulate_closed_loop": ".sim",
-    "simulate_truth": ".sim",
-    "convergence_time": ".metrics",
-    "max_error": ".metrics",
-    "monte_carlo_summary": ".metrics",
-    "monte_carlo_statistics": ".metrics",
-    "rms_error": ".metrics",
-    "rms_per_run": ".metrics",
-    "run_campaign": ".campaign",
-    "load_campaign": ".campaign",
-    "read_campaign": ".campaign",
-    "Campaign": ".campaign",
-}
-
 #: Sun 2011's names, once exported here: name -> their home. Deprecated aliases for one release (0.3):
 #: each use warns (FutureWarning), and they are in neither ``__all__`` nor ``dir(hinfnav)``.
 _MOVED = {name: "papers.sun2011" for name in (
@@ -160,7 +89,7 @@ _MOVED = {name: "papers.sun2011" for name in (
     "save_design",
 )}
 
-_lazy_getattr, __dir__ = lazy_exports(__name__, _EXPORTS)
+_lazy_getattr, __dir__ = lazy_exports(__name__)
 
 
 def __getattr__(name: str) -> object:
@@ -177,7 +106,6 @@ def __getattr__(name: str) -> object:
                           f"(from hinfnav.{home} import {name})", FutureWarning, stacklevel=2)
         return value
     return _lazy_getattr(name)
-
 
 __all__ = [
     "__version__",

@@ -8,7 +8,6 @@ tables (PEP 562, :mod:`hinfnav.core.lazy`) are checked against the imports that 
 read. ``benchmarks/bench_import.py`` prints the times.
 """
 
-import ast
 import importlib
 import json
 import os
@@ -18,6 +17,8 @@ import tomllib
 from pathlib import Path
 
 import pytest
+
+from hinfnav.core.lazy import type_checking_imports
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "hinfnav"
@@ -92,35 +93,23 @@ def test_importing_a_layer_loads_no_layer_above_it(layer):
 
 
 def _lazy_inits():
-    return sorted(p for p in PACKAGE.rglob("__init__.py") if "_EXPORTS" in p.read_text(encoding="utf-8"))
-
-
-def _type_checking_imports(tree: ast.Module) -> dict:
-    """Name -> relative module of the ``if TYPE_CHECKING:`` imports."""
-    out = {}
-    for node in tree.body:
-        if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING":
-            for stmt in node.body:
-                assert isinstance(stmt, ast.ImportFrom), ast.unparse(stmt)
-                for alias in stmt.names:
-                    out[alias.asname or alias.name] = "." * stmt.level + (stmt.module or "")
-    return out
+    return sorted(p for p in PACKAGE.rglob("__init__.py") if "lazy_exports(__name__)" in p.read_text(encoding="utf-8"))
 
 
 @pytest.mark.parametrize("path", _lazy_inits(), ids=lambda p: str(p.relative_to(ROOT)))
-def test_lazy_exports_are_what_type_checkers_read(path):
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    exports = next(ast.literal_eval(n.value) for n in tree.body
-                   if isinstance(n, ast.Assign) and getattr(n.targets[0], "id", None) == "_EXPORTS")
-    assert _type_checking_imports(tree) == exports
+def test_every_lazy_export_resolves_to_the_object_not_a_module(path):
     module_name = ".".join(path.relative_to(ROOT).parent.parts)
-    module = __import__(module_name, fromlist=["_"])
+    module = importlib.import_module(module_name)
+    exports = module._EXPORTS  # read by hinfnav.core.lazy from the TYPE_CHECKING block type checkers read
+    assert exports == type_checking_imports(path) and exports
     public = set(module.__all__) - {"__version__"}
-    assert set(exports) <= public, sorted(set(exports) - public)
+    assert set(exports) <= public, f"exported lazily but not in __all__: {sorted(set(exports) - public)}"
     for name in sorted(exports):  # a submodule named like an export (analysis.error_system), imported first,
         if (path.parent / f"{name}.py").exists():  # must not hide the export (core.lazy._LazyPackage)
             importlib.import_module(f"{module_name}.{name}")
-    for name in sorted(public):  # every exported name resolves, to an object of that name where it is defined
+    for name in sorted(public):
         value = getattr(module, name)
         assert not isinstance(value, type(sys)), f"{module_name}.{name} is a module, not the exported object"
     assert set(exports) <= set(dir(module))
+    with pytest.raises(AttributeError, match=f"{module_name}.*no_such_name"):
+        module.no_such_name  # noqa: B018

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .certificates import LMICertificate, brl_blocks, brl_matrix, certify_negative_definite, schur_gamma
     from .error_system import WorstCase, error_system, error_system_matrices, worst_case_norm
     from .norms import NORM_TOL, channel_norms, frequency_grid, frequency_response_sigma, h2_norm, hinf_norm, hinf_norm_bisection, hinf_norm_grid
@@ -16,37 +16,6 @@ if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS 
     from .pcrb import measurement_information, noise_fisher_information, posterior_crb, rms_bound
     from .riccati import stationary_lti_error_covariance, steady_state_kalman
     from .truncated import truncated_normal_moments
-
-#: Public name -> the module it comes from, imported on first use (PEP 562, :mod:`hinfnav.core.lazy`).
-_EXPORTS = {
-    "LMICertificate": ".certificates",
-    "brl_blocks": ".certificates",
-    "brl_matrix": ".certificates",
-    "certify_negative_definite": ".certificates",
-    "schur_gamma": ".certificates",
-    "WorstCase": ".error_system",
-    "error_system": ".error_system",
-    "error_system_matrices": ".error_system",
-    "worst_case_norm": ".error_system",
-    "NORM_TOL": ".norms",
-    "channel_norms": ".norms",
-    "frequency_grid": ".norms",
-    "frequency_response_sigma": ".norms",
-    "h2_norm": ".norms",
-    "hinf_norm": ".norms",
-    "hinf_norm_bisection": ".norms",
-    "hinf_norm_grid": ".norms",
-    "max_admissible_theta": ".hinf_riccati",
-    "steady_state_hinf": ".hinf_riccati",
-    "observer_form": ".observer",
-    "measurement_information": ".pcrb",
-    "noise_fisher_information": ".pcrb",
-    "posterior_crb": ".pcrb",
-    "rms_bound": ".pcrb",
-    "stationary_lti_error_covariance": ".riccati",
-    "steady_state_kalman": ".riccati",
-    "truncated_normal_moments": ".truncated",
-}
 
 __all__ = [
     "NORM_TOL",
@@ -78,4 +47,4 @@ __all__ = [
     "measurement_information",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .registry import (
         build_scenario, condition_parameters, load_providers, PROVIDER_GROUP, providers, register_scenario,
         registered_scenarios, scenario_entry, scenario_parameters,
@@ -26,37 +26,6 @@ if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS 
     from .stats import CellAccumulator, group_summary, rms_interval
     from .table import results_table, STATISTICS
     from .runner import campaign_client, campaign_units, clear_cache, read_campaign, run_campaign, run_unit, SERIAL
-
-#: Public name -> the module (relative to this package) it comes from.
-_EXPORTS = {
-    "register_scenario": ".registry",
-    "registered_scenarios": ".registry",
-    "scenario_entry": ".registry",
-    "scenario_parameters": ".registry",
-    "condition_parameters": ".registry",
-    "build_scenario": ".registry",
-    "load_providers": ".registry",
-    "PROVIDER_GROUP": ".registry",
-    "providers": ".registry",
-    "Campaign": ".spec",
-    "Cell": ".spec",
-    "load_campaign": ".spec",
-    "canonical": ".spec",
-    "digest": ".spec",
-    "LIMITS": ".spec",
-    "CellAccumulator": ".stats",
-    "group_summary": ".stats",
-    "rms_interval": ".stats",
-    "results_table": ".table",
-    "STATISTICS": ".table",
-    "run_campaign": ".runner",
-    "read_campaign": ".runner",
-    "campaign_client": ".runner",
-    "run_unit": ".runner",
-    "campaign_units": ".runner",
-    "clear_cache": ".runner",
-    "SERIAL": ".runner",
-}
 
 __all__ = [
     "register_scenario",
@@ -88,4 +57,4 @@ __all__ = [
     "SERIAL",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -21,12 +21,8 @@ from .exceptions import (
 from .lazy import lazy_exports
 from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, as_positive, as_real, as_vector
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .linalg import as_covariance, discretize, spectral_radius, sym
-
-#: Public name -> the module it comes from, imported on first use.
-_EXPORTS = {"as_covariance": ".linalg", "discretize": ".linalg", "spectral_radius": ".linalg", "sym": ".linalg"}
-
 
 __all__ = [
     "HinfnavError",
@@ -50,4 +46,4 @@ __all__ = [
     "discretize",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -2,26 +2,66 @@
 
 A layer's ``__init__`` that imported every submodule eagerly made ``import
 hinfnav.estimators`` load python-control and matplotlib, and ``import
-hinfnav.sim`` load cvxpy, through chains no one asked for. A lazy package
-lists its exports as ``name -> relative module`` and imports a submodule only
-when one of its names is first read; the same names are imported under
-``typing.TYPE_CHECKING`` for static type checkers (``tests/test_import_time.py``
-keeps the two lists equal).
+hinfnav.sim`` load cvxpy, through chains no one asked for. A lazy package writes
+its exports once, as the imports of an ``if TYPE_CHECKING:`` block: static type
+checkers read them there, and :func:`lazy_exports` reads the same block from the
+package's source, imports nothing, and loads a submodule only when one of its
+names is first read (the approach of scientific-python's SPEC 1 / ``lazy_loader``,
+with the stub inside the ``__init__``).
 
-Example (in a package's ``__init__.py``)::
+Example (a package's ``__init__.py``)::
 
-    _EXPORTS = {"simulate": ".montecarlo", "TruthModel": ".truth"}
-    __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+    from typing import TYPE_CHECKING
+
+    from ..core.lazy import lazy_exports
+
+    if TYPE_CHECKING:
+        from .montecarlo import simulate
+        from .truth import TruthModel
+
+    __all__ = ["simulate", "TruthModel"]
+
+    __getattr__, __dir__ = lazy_exports(__name__)
 """
 
 from __future__ import annotations
 
+import ast
 import importlib
 import sys
 import types
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
+from pathlib import Path
 
-__all__ = ["lazy_exports"]
+from .exceptions import HinfnavError
+
+__all__ = ["lazy_exports", "type_checking_imports"]
+
+
+def type_checking_imports(path: str | Path) -> dict[str, str]:
+    """The names imported in the top-level ``if TYPE_CHECKING:`` block of the module at ``path``.
+
+    Returns
+    -------
+    dict
+        Name -> the module it is imported from, relative as written (``".truth"``, ``"..lmi.solve"``).
+
+    Raises
+    ------
+    HinfnavError
+        The module has no such block, or the block holds anything but ``from … import …``.
+    """
+    tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    for node in tree.body:
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING":
+            out = {}
+            for stmt in node.body:
+                if not isinstance(stmt, ast.ImportFrom):
+                    raise HinfnavError(f"{path}: only 'from … import …' may stand in the TYPE_CHECKING block")
+                for alias in stmt.names:
+                    out[alias.asname or alias.name] = "." * stmt.level + (stmt.module or "")
+            return out
+    raise HinfnavError(f"{path}: a lazy package lists its exports in an 'if TYPE_CHECKING:' block; none found")
 
 
 class _LazyPackage(types.ModuleType):
@@ -41,24 +81,25 @@ class _LazyPackage(types.ModuleType):
         super().__setattr__(name, value)
 
 
-def lazy_exports(package: str, exports: Mapping[str, str]) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
+def lazy_exports(package: str) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
     """The module-level ``__getattr__`` and ``__dir__`` of a lazy package.
 
     Parameters
     ----------
     package : str
-        The package's ``__name__`` (it must be in ``sys.modules``: call this from its ``__init__``).
-    exports : mapping of str to str
-        Public name -> the module it comes from, relative to ``package`` (``".truth"``,
-        ``"..lmi.solve"``). Keep it as the package's global ``_EXPORTS``.
+        The package's ``__name__`` (it must be in ``sys.modules``: call this from its ``__init__``,
+        after its ``if TYPE_CHECKING:`` block of exports).
 
     Returns
     -------
     (__getattr__, __dir__)
         To be bound at the package's top level. A name is imported once, then cached in the
-        package's namespace; an unknown name raises AttributeError naming the package.
+        package's namespace; an unknown name raises AttributeError naming the package. The export
+        table (name -> relative module) is kept as the package's ``_EXPORTS``.
     """
     module = sys.modules[package]
+    exports = type_checking_imports(module.__file__)
+    module._EXPORTS = exports
     module.__class__ = _LazyPackage
 
     def __getattr__(name: str) -> object:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from ..lmi.solve import SOLVERS, SolverOptions
     from .from_file import design_from_system_file, design_summary
     from .io import check_design_system, load_design, save_design, system_fingerprint
@@ -20,37 +20,6 @@ if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS 
     from .result import SynthesisResult
     from .robust_hinf import FORMS, synthesize
     from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
-
-#: Public name -> the module it comes from, imported on first use (PEP 562, :mod:`hinfnav.core.lazy`).
-_EXPORTS = {
-    "SOLVERS": "..lmi.solve",
-    "SolverOptions": "..lmi.solve",
-    "design_from_system_file": ".from_file",
-    "design_summary": ".from_file",
-    "check_design_system": ".io",
-    "load_design": ".io",
-    "save_design": ".io",
-    "system_fingerprint": ".io",
-    "MixedFront": ".mixed",
-    "MixedSynthesisResult": ".mixed",
-    "front_gammas": ".mixed",
-    "knee_index": ".mixed",
-    "mixed_front": ".mixed",
-    "synthesize_mixed": ".mixed",
-    "compare_uncertainty_models": ".compare",
-    "small_gain_number": ".explain",
-    "PolytopicResult": ".polytopic",
-    "certify_polytopic": ".polytopic",
-    "synthesize_polytopic": ".polytopic",
-    "recertify": ".recertify",
-    "SynthesisResult": ".result",
-    "FORMS": ".robust_hinf",
-    "synthesize": ".robust_hinf",
-    "SampleSet": ".samples",
-    "check_plant": ".samples",
-    "check_samples": ".samples",
-    "default_uncertainty_samples": ".samples",
-}
 
 __all__ = [
     "synthesize",
@@ -82,4 +51,4 @@ __all__ = [
     "compare_uncertainty_models",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
     from .huber import HuberUpdate, huber_update
     from .adaptive import RateAdaptive, StrongTracking
@@ -22,44 +22,6 @@ if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS 
     from .lti import LTIFilter
     from .sigma_point import SigmaPointFilter
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
-
-#: Public name -> the module it comes from, imported on first use (PEP 562, :mod:`hinfnav.core.lazy`).
-_EXPORTS = {
-    "EstimateHistory": ".base",
-    "Estimator": ".base",
-    "FilterState": ".base",
-    "StepOutput": ".base",
-    "check_estimator_inputs": ".base",
-    "HuberUpdate": ".huber",
-    "huber_update": ".huber",
-    "RateAdaptive": ".adaptive",
-    "StrongTracking": ".adaptive",
-    "AugmentedEKF": ".augmented",
-    "AugmentedInputAdaptiveKF": ".augmented",
-    "AugmentedInputHuberSTKF": ".augmented",
-    "AugmentedInputKF": ".augmented",
-    "AugmentedInputSTKF": ".augmented",
-    "ExtendedStateKalmanFilter": ".extended_state",
-    "FusedExtendedStateFilter": ".saturated_state",
-    "SaturatedExtendedStateFilter": ".saturated_state",
-    "KalmanCorrection": ".correction",
-    "drop_missing": ".correction",
-    "joseph_update": ".correction",
-    "kalman_gain": ".correction",
-    "HuberCorrection": ".huber_filter",
-    "HuberFilter": ".huber_filter",
-    "RecursiveHInfinityFilter": ".recursive_hinf",
-    "OUTPUTS": ".kalman",
-    "ExtendedKalmanFilter": ".kalman",
-    "KalmanCore": ".kalman",
-    "StrongTrackingEKF": ".kalman",
-    "LTIFilter": ".lti",
-    "SigmaPointFilter": ".sigma_point",
-    "build_estimator": ".registry",
-    "estimator_entry": ".registry",
-    "register_estimator": ".registry",
-    "registered_estimators": ".registry",
-}
 
 __all__ = [
     "Estimator",
@@ -98,4 +60,4 @@ __all__ = [
     "estimator_entry",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

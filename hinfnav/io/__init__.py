@@ -15,26 +15,10 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .outputs import MARKER, atomic_output_dir, check_output_dir, lock_path, output_lock, to_json, write_json
     from .progress import bar_disabled
     from .provenance import LIBRARIES, git_commit, package_version, provenance
-
-#: Public name -> the module it comes from, imported on first use (PEP 562, :mod:`hinfnav.core.lazy`).
-_EXPORTS = {
-    "MARKER": ".outputs",
-    "atomic_output_dir": ".outputs",
-    "check_output_dir": ".outputs",
-    "lock_path": ".outputs",
-    "output_lock": ".outputs",
-    "to_json": ".outputs",
-    "write_json": ".outputs",
-    "bar_disabled": ".progress",
-    "LIBRARIES": ".provenance",
-    "git_commit": ".provenance",
-    "package_version": ".provenance",
-    "provenance": ".provenance",
-}
 
 __all__ = [
     "MARKER",
@@ -51,4 +35,4 @@ __all__ = [
     "provenance",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)

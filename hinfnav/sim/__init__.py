@@ -4,26 +4,10 @@ from typing import TYPE_CHECKING
 
 from ..core.lazy import lazy_exports
 
-if TYPE_CHECKING:  # what static type checkers read; the same names as _EXPORTS (tests/test_import_time.py)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .closed_loop import simulate_closed_loop
     from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate, simulate_batches
     from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
-
-#: Public name -> the module it comes from, imported on first use (PEP 562, :mod:`hinfnav.core.lazy`).
-_EXPORTS = {
-    "simulate_closed_loop": ".closed_loop",
-    "SimulationResult": ".montecarlo",
-    "resolve_estimator": ".montecarlo",
-    "run_estimator": ".montecarlo",
-    "simulate": ".montecarlo",
-    "simulate_batches": ".montecarlo",
-    "Truth": ".truth",
-    "TruthModel": ".truth",
-    "child_rngs": ".truth",
-    "draw_noise": ".truth",
-    "noise_models": ".truth",
-    "simulate_truth": ".truth",
-}
 
 __all__ = [
     "TruthModel",
@@ -40,4 +24,4 @@ __all__ = [
     "draw_noise",
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__)
