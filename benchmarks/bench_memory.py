@@ -14,7 +14,7 @@ import sys
 import time
 
 HISTORIES = (
-    "import sys, hinfnav as hn; r = hn.simulate(hn.Scenario(), 'published', runs=int(sys.argv[1]), seed=0); "
+    "import sys, hinfnav as hn; from hinfnav.papers import sun2011; r = hn.simulate(sun2011.Scenario(), 'published', runs=int(sys.argv[1]), seed=0); "
     "print(r.x.nbytes + r.xhat.nbytes + r.u.nbytes + r.y.nbytes)"
 )
 

@@ -17,7 +17,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
-from hinfnav.core.provenance import package_version  # noqa: E402
+from hinfnav.io.provenance import package_version  # noqa: E402
 
 project = "hinfnav"
 author = "the hinfnav authors"

@@ -6,126 +6,106 @@ H∞ filtering", Journal of Astronautics 32(7), 1462–1470, 2011
 (DOI 10.3873/j.issn.1000-1328.2011.07.005), and its peer papers.
 
 The package is layered, each layer importing only those before it:
-``core`` → ``systems`` → ``noise`` → ``analysis`` → ``lmi`` → ``design`` →
-``estimators`` → ``control`` → ``sim`` → ``metrics`` → ``plotting`` →
-``papers`` → ``cli`` (checked by import-linter, ``pyproject.toml``).
-The names below are the public API, re-exported from those layers.
+``core`` → ``systems`` → ``noise`` → ``analysis`` → ``lmi`` → ``io`` →
+``design`` → ``estimators`` → ``control`` → ``sim`` → ``metrics`` →
+``plotting`` → ``campaign`` → ``papers`` → ``cli`` (checked by import-linter,
+``pyproject.toml``, and at import time by ``tests/test_import_time.py``).
+The names below are the generic public API, re-exported from those layers;
+each paper's names live in its own package, :mod:`hinfnav.papers.sun2011` and
+its peers.
 
-Names are loaded lazily (PEP 562): ``import hinfnav`` is cheap, and the heavy
-layers (cvxpy, python-control, matplotlib) are imported on first use, so the
-command line starts fast.
+Names are loaded lazily (PEP 562, :mod:`hinfnav.core.lazy`): ``import hinfnav``
+is cheap, and the heavy layers (cvxpy, python-control, matplotlib) are imported
+on first use, so the command line starts fast.
+
+Sun 2011's names (``hinfnav.Scenario``, ``hinfnav.design_for_scenario``, …)
+were re-exported here up to 0.2; they still resolve, for one release, with a
+:class:`FutureWarning` naming their home (``hinfnav.papers.sun2011.Scenario``).
+A FutureWarning rather than a DeprecationWarning: Python shows a
+DeprecationWarning only when it is attributed to ``__main__``, and ``from hinfnav
+import Scenario`` reaches this module's ``__getattr__`` through the import
+machinery, so a notebook's or a script's user would never see it.
 """
 
 import importlib
+import sys
+import warnings
+from typing import TYPE_CHECKING
 
-from .core.provenance import package_version
+from .core.lazy import lazy_exports
 
-#: Public name -> the module (relative to this package) it comes from.
-_EXPORTS = {
-    "h2_norm": "analysis",
-    "hinf_norm": "analysis",
-    "observer_form": "analysis",
-    "steady_state_hinf": "analysis",
-    "steady_state_kalman": "analysis",
-    "truncated_normal_moments": "analysis",
-    "worst_case_norm": "analysis",
-    "LinearFeedback": "control",
-    "CertificationError": "core",
-    "HinfnavError": "core",
-    "InfeasibleLMIError": "core",
-    "InputError": "core",
-    "SynthesisError": "core",
-    "UnstablePlantError": "core",
-    "discretize": "core",
-    "SampleSet": "design",
-    "SolverOptions": "design",
-    "SynthesisResult": "design",
-    "PolytopicResult": "design",
-    "synthesize_polytopic": "design",
-    "recertify": "design",
-    "PolytopicSystem": "systems",
-    "two_mass_spring": "systems",
-    "synthesize": "design",
-    "run_campaign": "campaign",
-    "load_campaign": "campaign",
-    "read_campaign": "campaign",
-    "Campaign": "campaign",
-    "synthesize_mixed": "design",
-    "MixedSynthesisResult": "design",
-    "HuberFilter": "estimators",
-    "RecursiveHInfinityFilter": "estimators",
-    "mixed_design_for_scenario": "papers.sun2011",
-    "EstimateHistory": "estimators",
-    "Estimator": "estimators",
-    "ExtendedKalmanFilter": "estimators",
-    "FilterState": "estimators",
-    "LTIFilter": "estimators",
-    "StepOutput": "estimators",
-    "build_estimator": "estimators",
-    "huber_update": "estimators",
-    "register_estimator": "estimators",
-    "registered_estimators": "estimators",
-    "convergence_time": "metrics",
-    "max_error": "metrics",
-    "monte_carlo_summary": "metrics",
-    "monte_carlo_statistics": "metrics",
-    "rms_error": "metrics",
-    "rms_per_run": "metrics",
-    "NOISE_NAMES": "noise",
-    "make_noise": "noise",
-    "EKF": "papers.sun2011",
-    "FILTER_NAMES": "papers.sun2011",
-    "GammaSweep": "papers.sun2011",
-    "KalmanLimit": "papers.sun2011",
-    "Scenario": "papers.sun2011",
-    "build_ekf": "papers.sun2011",
-    "compare_with_published": "papers.sun2011",
-    "design_for_scenario": "papers.sun2011",
-    "design_report": "papers.sun2011",
-    "gamma_sweep": "papers.sun2011",
-    "infer_sampling_time": "papers.sun2011",
-    "kalman_limit": "papers.sun2011",
-    "load_design": "papers.sun2011",
-    "lti_error_covariance": "papers.sun2011",
-    "make_estimator": "papers.sun2011",
-    "published_filter": "papers.sun2011",
-    "range_angle_measurements": "papers.sun2011",
-    "save_design": "papers.sun2011",
-    "SimulationResult": "sim",
-    "TruthModel": "sim",
-    "simulate": "sim",
-    "simulate_closed_loop": "sim",
-    "simulate_truth": "sim",
-    "LinearMeasurement": "systems",
-    "LinearSystem": "systems",
-    "MeasurementModel": "systems",
-    "RangeAzimuthElevation": "systems",
-    "Saturated": "systems",
-    "StateSpec": "systems",
-    "UncertainSystem": "systems",
-    "hill_matrices": "systems",
-    "position_from_range_angles": "systems",
-    "range_angles": "systems",
-    "uncertainty_F": "systems",
-    "uncertainty_structure": "systems",
-}
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .core import (
+        CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
+        UnstablePlantError,
+    )
+    from .systems import (
+        hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
+        position_from_range_angles, range_angles, RangeAzimuthElevation, Saturated, StateSpec,
+        two_mass_spring, UncertainSystem, uncertainty_F, uncertainty_structure,
+    )
+    from .noise import make_noise, NOISE_NAMES
+    from .analysis import (
+        h2_norm, hinf_norm, observer_form, steady_state_hinf, steady_state_kalman, truncated_normal_moments,
+        worst_case_norm,
+    )
+    from .design import (
+        MixedSynthesisResult, PolytopicResult, recertify, SampleSet, SolverOptions, SynthesisResult,
+        synthesize, synthesize_mixed, synthesize_polytopic,
+    )
+    from .estimators import (
+        build_estimator, EstimateHistory, Estimator, ExtendedKalmanFilter, FilterState, huber_update,
+        HuberFilter, LTIFilter, RecursiveHInfinityFilter, register_estimator, registered_estimators,
+        StepOutput,
+    )
+    from .control import LinearFeedback
+    from .sim import simulate, simulate_closed_loop, simulate_truth, SimulationResult, TruthModel
+    from .metrics import (
+        convergence_time, max_error, monte_carlo_statistics, monte_carlo_summary, rms_error, rms_per_run,
+    )
+    from .campaign import Campaign, load_campaign, read_campaign, run_campaign
+
+#: Sun 2011's names, once exported here: name -> their home. Deprecated aliases for one release (0.3):
+#: each use warns (FutureWarning), and they are in neither ``__all__`` nor ``dir(hinfnav)``.
+_MOVED = {name: "papers.sun2011" for name in (
+    "mixed_design_for_scenario",
+    "EKF",
+    "FILTER_NAMES",
+    "GammaSweep",
+    "KalmanLimit",
+    "Scenario",
+    "build_ekf",
+    "compare_with_published",
+    "design_for_scenario",
+    "design_report",
+    "gamma_sweep",
+    "infer_sampling_time",
+    "kalman_limit",
+    "load_design",
+    "lti_error_covariance",
+    "make_estimator",
+    "published_filter",
+    "range_angle_measurements",
+    "save_design",
+)}
+
+_lazy_getattr, __dir__ = lazy_exports(__name__)
 
 
-def __getattr__(name):
-    if name == "__version__":  # from git in a checkout (see core.provenance.package_version); computed once
-        globals()[name] = value = package_version()
+def __getattr__(name: str) -> object:
+    if name == "__version__":  # from git in a checkout (see io.provenance.package_version); computed once
+        globals()[name] = value = importlib.import_module(".io.provenance", __name__).package_version()
         return value
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'hinfnav' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
-
+    home = _MOVED.get(name)
+    if home is not None:  # not cached: every use warns
+        value = getattr(importlib.import_module(f".{home}", __name__), name)
+        # ``from hinfnav import X`` first probes X from importlib's frozen frames (hasattr), then reads it
+        # from the importing line: warn once, on the second, which points at the user's line.
+        if not sys._getframe(1).f_code.co_filename.startswith("<frozen importlib"):
+            warnings.warn(f"hinfnav.{name} is deprecated and will be removed after 0.3: use hinfnav.{home}.{name} "
+                          f"(from hinfnav.{home} import {name})", FutureWarning, stacklevel=2)
+        return value
+    return _lazy_getattr(name)
 
 __all__ = [
     "__version__",
@@ -164,7 +144,6 @@ __all__ = [
     "Campaign",
     "synthesize_mixed",
     "MixedSynthesisResult",
-    "mixed_design_for_scenario",
     "HuberFilter",
     "RecursiveHInfinityFilter",
     "SynthesisResult",
@@ -198,25 +177,6 @@ __all__ = [
     "convergence_time",
     "monte_carlo_summary",
     "monte_carlo_statistics",
-    # Sun et al. (2011)
-    "Scenario",
-    "published_filter",
-    "infer_sampling_time",
-    "make_estimator",
-    "FILTER_NAMES",
-    "EKF",
-    "build_ekf",
-    "range_angle_measurements",
-    "kalman_limit",
-    "KalmanLimit",
-    "lti_error_covariance",
-    "design_for_scenario",
-    "gamma_sweep",
-    "GammaSweep",
-    "design_report",
-    "compare_with_published",
-    "save_design",
-    "load_design",
     # errors
     "HinfnavError",
     "InputError",

@@ -17,7 +17,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from .core.exceptions import HinfnavError, InputError
-from .core.outputs import check_output_dir
+from .io.outputs import check_output_dir
 from .core.validation import check_new_file
 
 __all__ = ["main", "simulate_report", "format_simulate_report", "RegistryChoices", "FILTER_CHOICES",

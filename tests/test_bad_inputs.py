@@ -30,7 +30,7 @@ from hinfnav.papers.sun2011.report import simulate_report
 from hinfnav.sim.truth import noise_models
 
 #: 20 samples of the paper's scenario: every row that simulates stays cheap.
-SHORT = hn.Scenario(duration_s=2.0, rms_window_s=(0.0, 2.0))
+SHORT = sun.Scenario(duration_s=2.0, rms_window_s=(0.0, 2.0))
 #: A small stable plant for synthesize rows (no solver runs in any row).
 A2, B2, C2, D2, L2 = 0.5 * np.eye(2), np.eye(2), np.eye(1, 2), np.eye(1), np.eye(2)
 T5 = np.arange(5.0)
@@ -53,7 +53,7 @@ class Ctx:
 
     @cached_property
     def design_file(self):
-        return str(hn.save_design(self.design, self.tmp / "d.json"))
+        return str(sun.save_design(self.design, self.tmp / "d.json"))
 
     @cached_property
     def a_file(self):
@@ -103,7 +103,7 @@ API_ROWS = [
     _row("runs-float", lambda c: hn.simulate(SHORT, "published", runs=2.5), r"\bruns\b"),
     _row("runs-str", lambda c: hn.simulate(SHORT, "published", runs="3"), r"\bruns\b"),
     _row("runs-bool", lambda c: hn.simulate(SHORT, "published", runs=True), r"\bruns\b"),
-    _row("runs-1e12", lambda c: hn.simulate(hn.Scenario(), "published", runs=10**12), r"\bruns\b"),
+    _row("runs-1e12", lambda c: hn.simulate(sun.Scenario(), "published", runs=10**12), r"\bruns\b"),
     _row("report-runs-1e12", lambda c: simulate_report(runs=10**12), r"\bruns\b"),
     _row("batch_size-0", lambda c: hn.simulate(SHORT, "published", batch_size=0), r"\bbatch_size\b"),
     _row("batch_size-float", lambda c: hn.simulate(SHORT, "published", batch_size=2.5), r"\bbatch_size\b"),
@@ -123,22 +123,22 @@ API_ROWS = [
     _row("scenario-None", lambda c: hn.simulate(None, "published"), r"\bscenario\b"),
     _row("closed-loop-scenario-str", lambda c: hn.simulate_closed_loop("sun2011", "published"), r"\bscenario\b"),
     # -- Scenario fields -----------------------------------------------------------------------------------
-    _row("dt-0", lambda c: hn.Scenario(dt=0), r"\bdt\b"),
-    _row("dt-negative", lambda c: hn.Scenario(dt=-0.1), r"\bdt\b"),
-    _row("mass-0", lambda c: hn.Scenario(mass=0), r"\bmass\b"),
-    _row("K-shape", lambda c: hn.Scenario(K=np.zeros((3, 5))), r"\bK\b"),
-    _row("x0-length", lambda c: hn.Scenario(x0=np.zeros(5)), r"\bx0\b"),
-    _row("B-nan", lambda c: hn.Scenario(B=np.full((6, 6), np.nan)), r"\bB\b"),
-    _row("delta_bar-negative", lambda c: hn.Scenario(delta_bar=-1), r"\bdelta_bar\b"),
-    _row("rms_window-outside-run", lambda c: hn.Scenario(rms_window_s=(0, 2000)), r"\brms_window_s\b"),
-    _row("rms_window-not-a-pair", lambda c: hn.Scenario(rms_window_s=5), r"\brms_window_s\b"),
+    _row("dt-0", lambda c: sun.Scenario(dt=0), r"\bdt\b"),
+    _row("dt-negative", lambda c: sun.Scenario(dt=-0.1), r"\bdt\b"),
+    _row("mass-0", lambda c: sun.Scenario(mass=0), r"\bmass\b"),
+    _row("K-shape", lambda c: sun.Scenario(K=np.zeros((3, 5))), r"\bK\b"),
+    _row("x0-length", lambda c: sun.Scenario(x0=np.zeros(5)), r"\bx0\b"),
+    _row("B-nan", lambda c: sun.Scenario(B=np.full((6, 6), np.nan)), r"\bB\b"),
+    _row("delta_bar-negative", lambda c: sun.Scenario(delta_bar=-1), r"\bdelta_bar\b"),
+    _row("rms_window-outside-run", lambda c: sun.Scenario(rms_window_s=(0, 2000)), r"\brms_window_s\b"),
+    _row("rms_window-not-a-pair", lambda c: sun.Scenario(rms_window_s=5), r"\brms_window_s\b"),
     # was: "R must be positive definite" (R = D Dᵀ is internal)
-    _row("D-singular-ekf", lambda c: hn.simulate(hn.Scenario(D=np.zeros((3, 3)), duration_s=2.0,
+    _row("D-singular-ekf", lambda c: hn.simulate(sun.Scenario(D=np.zeros((3, 3)), duration_s=2.0,
                                                              rms_window_s=(0, 2)), "ekf"), r"\bD\b"),
-    _row("D-singular-kalman-limit", lambda c: hn.kalman_limit(hn.Scenario(D=np.diag([0.1, 0.1, 0.0]))), r"\bD\b"),
+    _row("D-singular-kalman-limit", lambda c: sun.kalman_limit(sun.Scenario(D=np.diag([0.1, 0.1, 0.0]))), r"\bD\b"),
     # was: "C_F must be invertible" (C_F is the designed filter's; the user gave L)
-    _row("L-singular-designed", lambda c: sun.make_estimator(hn.Scenario(L=np.zeros((6, 6))), "designed"), r"\bL\b"),
-    _row("L-3x6-designed", lambda c: sun.make_estimator(hn.Scenario(L=np.eye(3, 6)), "designed"), r"\bL\b"),
+    _row("L-singular-designed", lambda c: sun.make_estimator(sun.Scenario(L=np.zeros((6, 6))), "designed"), r"\bL\b"),
+    _row("L-3x6-designed", lambda c: sun.make_estimator(sun.Scenario(L=np.eye(3, 6)), "designed"), r"\bL\b"),
     _row("L-singular-observer", lambda c: hn.synthesize(hn.UncertainSystem(A2, B2, C2, D2, np.zeros((2, 2))), form="observer"), r"\bL\b"),
     # -- noise ---------------------------------------------------------------------------------------------
     _row("noise-name", lambda c: hn.simulate(SHORT, "published", noise="pink"), r"\bnoise\b"),
@@ -190,8 +190,8 @@ API_ROWS = [
     _row("design-delta_bar-1e200", lambda c: sun.design_for_scenario(None, 1e200), r"\bdelta_bar\b"),
     _row("design-delta_bar-1e9", lambda c: sun.design_for_scenario(None, 1e9), r"\bdelta_bar\b", UnstablePlantError),
     # was: an empty sweep returned
-    _row("gamma-sweep-empty", lambda c: hn.gamma_sweep(None, []), r"\bdelta_bars\b"),
-    _row("gamma-sweep-scalar", lambda c: hn.gamma_sweep(None, 0.05), r"\bdelta_bars\b"),
+    _row("gamma-sweep-empty", lambda c: sun.gamma_sweep(None, []), r"\bdelta_bars\b"),
+    _row("gamma-sweep-scalar", lambda c: sun.gamma_sweep(None, 0.05), r"\bdelta_bars\b"),
     # was: LinAlgError Singular matrix
     _row("observer-form-C_F-singular", lambda c: hn.observer_form(0.5 * np.eye(2), np.eye(2, 1), np.zeros((2, 2)),
                                                                   0.5 * np.eye(2), np.eye(1, 2)), r"\bC_F\b"),
@@ -200,28 +200,28 @@ API_ROWS = [
          r"\bsystem\b"),
     _row("design-delta_points", lambda c: sun.design_for_scenario(None, 0.05, delta_points=1), r"\bdelta_points\b"),
     # -- design files --------------------------------------------------------------------------------------
-    _row("load-missing", lambda c: hn.load_design(c.tmp / "nope.json"), r"nope\.json"),
-    _row("load-not-json", lambda c: hn.load_design(c.text_file("bad.json", "{not json")), r"JSON"),
-    _row("load-json-list", lambda c: hn.load_design(c.text_file("list.json", "[1, 2]")), r"design file"),
+    _row("load-missing", lambda c: sun.load_design(c.tmp / "nope.json"), r"nope\.json"),
+    _row("load-not-json", lambda c: sun.load_design(c.text_file("bad.json", "{not json")), r"JSON"),
+    _row("load-json-list", lambda c: sun.load_design(c.text_file("list.json", "[1, 2]")), r"design file"),
     # was: TypeError expected str, bytes or os.PathLike object
-    _row("load-path-None", lambda c: hn.load_design(None), r"\bpath\b"),
-    _row("load-edited", lambda c: hn.load_design(c.edited_design(_bump_A)), r"edited"),
+    _row("load-path-None", lambda c: sun.load_design(None), r"\bpath\b"),
+    _row("load-edited", lambda c: sun.load_design(c.edited_design(_bump_A)), r"edited"),
     # was: KeyError 'gamma'
-    _row("load-no-certificate", lambda c: hn.load_design(c.edited_design(_del("certificate"))), r"design file"),
-    _row("load-another-T", lambda c: hn.load_design(c.design_file, scenario=hn.Scenario(dt=0.2)), r"\bT\b"),
-    _row("load-scenario-str", lambda c: hn.load_design(c.design_file, scenario="paper"), r"\bscenario\b"),
+    _row("load-no-certificate", lambda c: sun.load_design(c.edited_design(_del("certificate"))), r"design file"),
+    _row("load-another-T", lambda c: sun.load_design(c.design_file, scenario=sun.Scenario(dt=0.2)), r"\bT\b"),
+    _row("load-scenario-str", lambda c: sun.load_design(c.design_file, scenario="paper"), r"\bscenario\b"),
     # was: AttributeError 'str' object has no attribute 'delta_bar'
-    _row("save-not-a-design", lambda c: hn.save_design("x", c.tmp / "x.json"), r"\bresult\b"),
+    _row("save-not-a-design", lambda c: sun.save_design("x", c.tmp / "x.json"), r"\bresult\b"),
     # was: NotADirectoryError
-    _row("save-under-a-file", lambda c: hn.save_design(c.design, c.a_file + "/x.json"), r"\bpath\b"),
-    _row("save-path-None", lambda c: hn.save_design(c.design, None), r"\bpath\b"),
-    _row("save-scenario-str", lambda c: hn.save_design(c.design, c.tmp / "x.json", scenario="x"), r"\bscenario\b"),
-    _row("simulate-design-another-T", lambda c: hn.simulate(hn.Scenario(dt=0.2, duration_s=2.0, rms_window_s=(0, 2)),
+    _row("save-under-a-file", lambda c: sun.save_design(c.design, c.a_file + "/x.json"), r"\bpath\b"),
+    _row("save-path-None", lambda c: sun.save_design(c.design, None), r"\bpath\b"),
+    _row("save-scenario-str", lambda c: sun.save_design(c.design, c.tmp / "x.json", scenario="x"), r"\bscenario\b"),
+    _row("simulate-design-another-T", lambda c: hn.simulate(sun.Scenario(dt=0.2, duration_s=2.0, rms_window_s=(0, 2)),
                                                             c.design), r"\bT\b"),
     # was: TypeError expected str, bytes or os.PathLike object
     _row("report-design-int", lambda c: simulate_report(design=5), r"\bpath\b"),
     # was: AttributeError 'int' object has no attribute 'A_F'
-    _row("compare-design-int", lambda c: hn.compare_with_published(design=5), r"\bdesign\b"),
+    _row("compare-design-int", lambda c: sun.compare_with_published(design=5), r"\bdesign\b"),
     # -- metrics -------------------------------------------------------------------------------------------
     _row("rms-nan", lambda c: hn.rms_error(np.full((2, 5, 3), np.nan), T5, (0, 4)), r"\berror\b"),
     _row("rms-shape", lambda c: hn.rms_error(np.zeros(5), T5, (0, 4)), r"\berror\b"),
@@ -377,18 +377,18 @@ def test_unstable_closed_loop_delta_is_refused_and_a_stable_one_runs():
 
 def test_destabilizing_gain_is_refused():
     # was: accepted. Φ + Γ K with K = 1e6 has spectral radius ≈ 316 at T = 0.1 s
-    sc = hn.Scenario(K=np.full((3, 6), 1e6), duration_s=2.0, rms_window_s=(0.0, 2.0))
+    sc = sun.Scenario(K=np.full((3, 6), 1e6), duration_s=2.0, rms_window_s=(0.0, 2.0))
     with pytest.raises(InputError, match=r"\bK\b.*unstable|unstable.*\bK\b"):
         hn.simulate(sc, "published")
 
 
 def test_filter_designed_for_another_T_is_refused(ctx):
     # was: the published filter (T = 0.1 s) ran at T = 1 s without a word
-    sc = hn.Scenario(dt=1.0, duration_s=20.0, rms_window_s=(0.0, 20.0))
+    sc = sun.Scenario(dt=1.0, duration_s=20.0, rms_window_s=(0.0, 20.0))
     with pytest.raises(InputError, match=r"T = 0\.1 s.*dt = 1 s"):
         hn.simulate(sc, "published")
     with pytest.raises(InputError, match=r"sampling time T = 0\.1 s .* T = 1 s"):
-        hn.load_design(ctx.design_file, scenario=sc)
+        sun.load_design(ctx.design_file, scenario=sc)
 
 
 def test_colored_noise_follows_the_scenario_T():

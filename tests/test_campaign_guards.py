@@ -21,7 +21,7 @@ import hinfnav.papers  # noqa: F401 - registers Sun 2011's scenario and estimato
 from hinfnav.campaign import Campaign, load_campaign, run_campaign
 from hinfnav.cli import main
 from hinfnav.core.exceptions import InputError
-from hinfnav.core.outputs import atomic_output_dir, lock_path, output_lock
+from hinfnav.io.outputs import atomic_output_dir, lock_path, output_lock
 from hinfnav.papers.sun2011 import Scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -86,7 +86,7 @@ def test_output_lock_is_the_os_lock_not_a_pid_file(tmp_path):
         (tmp / "a.txt").write_text("1")
     assert (out / "a.txt").read_text() == "1" and not lock_path(out).exists()
     # held by another process: refused, for reproduce's atomic folders and campaign folders alike
-    holder = subprocess.Popen([sys.executable, "-c", "import sys, time\nfrom hinfnav.core.outputs import output_lock\n"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time\nfrom hinfnav.io.outputs import output_lock\n"
                                f"with output_lock({str(out)!r}):\n    print('held', flush=True)\n    time.sleep(60)\n"],
                               stdout=subprocess.PIPE, text=True, env=ENV)
     try:

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import hinfnav as hn
+from hinfnav.papers import sun2011
 from hinfnav.cli import main
 from hinfnav.core.exceptions import InputError
 from hinfnav.design import design_from_system_file
@@ -28,7 +29,7 @@ def run_cli(capsys, *args):
 @pytest.fixture(scope="module")
 def di_file(tmp_path_factory):
     res = hn.synthesize(hn.UncertainSystem(A_DI, B_DI, C_DI, 0.1 * np.eye(2), np.eye(4), dt=T), form="observer")
-    return hn.save_design(res, tmp_path_factory.mktemp("d") / "di.json"), res
+    return sun2011.save_design(res, tmp_path_factory.mktemp("d") / "di.json"), res
 
 
 def _edited(src, tmp_path, edit):
@@ -44,7 +45,7 @@ def test_user_design_is_saved_with_its_own_system(di_file):
     d = json.loads(Path(path).read_text())
     # the user's 4-state plant, not Sun 2011's 6-state one
     assert np.array_equal(np.array(d["system"]["A"]), A_DI) and d["extra"] == {}
-    back = hn.load_design(path)
+    back = sun2011.load_design(path)
     assert np.array_equal(back.B_F, res.B_F) and back.gamma == res.gamma
 
 
@@ -67,7 +68,7 @@ def test_recertify_passes_on_an_untouched_file(di_file):
 ], ids=["B_F-x3-and-gamma", "B_F-x3", "gamma", "verified-norm", "witness", "system"])
 def test_an_edited_file_is_refused(di_file, tmp_path, edit, capsys):
     bad = _edited(di_file[0], tmp_path, edit)
-    for load in (hn.load_design, hn.recertify):
+    for load in (sun2011.load_design, hn.recertify):
         with pytest.raises(InputError, match="edited"):
             load(bad)
     rc, _, err = run_cli(capsys, "design", "--recertify", str(bad))

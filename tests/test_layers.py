@@ -1,8 +1,12 @@
 """The package's shape: one-way layers, no import cycle, no module over 600 lines.
 
 Sources: the layer order of issue 7 (core → systems → noise → analysis → lmi →
-design → estimators → control → sim → metrics → plotting → papers → cli),
-written as import-linter contracts in ``pyproject.toml``.
+io → design → estimators → control → sim → metrics → plotting → campaign →
+papers → cli; io added by issue 23), written as import-linter contracts in
+``pyproject.toml``, which also holds the papers' independence contract (with its
+declared crossings) and the no-cycle contract (import-linter's ``acyclic_siblings``,
+issue 23); :func:`test_lint_imports_contracts_kept` runs them all. That the layers
+also hold at import time is ``tests/test_import_time.py``.
 """
 
 import ast
@@ -11,7 +15,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import grimp
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,33 +38,6 @@ def test_lint_imports_contracts_kept():
     proc = subprocess.run([exe], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
     assert "broken" not in proc.stdout.split("Contracts:")[-1].replace("0 broken", "")
-
-
-def test_no_import_cycle():
-    graph = grimp.build_graph("hinfnav")
-    modules = sorted(m for m in graph.modules if m != "hinfnav")
-    edges = {m: {d for d in graph.find_modules_directly_imported_by(m) if d.startswith("hinfnav.")} for m in modules}
-    # a package's __init__ re-exports its submodules: that is not a cycle, so drop edges parent -> child
-    for m in modules:
-        edges[m] = {d for d in edges[m] if not d.startswith(m + ".")}
-    state, cycles = {}, []
-
-    def visit(m, stack):
-        state[m] = 1
-        stack.append(m)
-        for d in sorted(edges.get(m, ())):
-            if state.get(d) == 1:
-                cycles.append(stack[stack.index(d):] + [d])
-            elif d not in state:
-                visit(d, stack)
-        stack.pop()
-        state[m] = 2
-
-    sys.setrecursionlimit(10000)
-    for m in modules:
-        if m not in state:
-            visit(m, [])
-    assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles[:5])
 
 
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(ROOT)))

@@ -11,6 +11,7 @@ import pytest
 import scipy.linalg
 
 import hinfnav as hn
+from hinfnav.papers import sun2011
 from hinfnav.analysis import error_system, error_system_matrices, hinf_norm_bisection, schur_gamma
 from hinfnav.core.exceptions import SynthesisError
 from hinfnav.design.mixed import front_gammas, knee_index, synthesize_mixed
@@ -28,7 +29,7 @@ DELTA_BAR = 0.05
 
 @pytest.fixture(scope="module")
 def scenario():
-    return hn.Scenario()
+    return sun2011.Scenario()
 
 
 @pytest.fixture(scope="module")

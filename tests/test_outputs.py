@@ -15,8 +15,9 @@ import time
 import pytest
 
 import hinfnav as hn
+from hinfnav.papers import sun2011
 from hinfnav.cli import FILTER_CHOICES, NOISE_CHOICES, PAPER_CHOICES, SOLVER_CHOICES, main
-from hinfnav.core.outputs import MARKER, atomic_output_dir, check_output_dir
+from hinfnav.io.outputs import MARKER, atomic_output_dir, check_output_dir
 
 REPRO = [sys.executable, "-m", "hinfnav", "reproduce", "--paper", "sun2011", "--runs", "2"]
 
@@ -41,7 +42,7 @@ def test_cli_choices_are_the_packages_own_lists():
     from hinfnav.estimators import registered_estimators
 
     assert set(FILTER_NAMES) <= set(FILTER_CHOICES)
-    assert set(FILTER_CHOICES) == set(registered_estimators(hn.Scenario()))
+    assert set(FILTER_CHOICES) == set(registered_estimators(sun2011.Scenario()))
     assert tuple(NOISE_CHOICES) == NOISE_NAMES
     assert tuple(SOLVER_CHOICES) == SOLVERS
     from hinfnav.papers import SELECTIONS
@@ -58,15 +59,15 @@ def test_design_save_then_simulate_and_refusal_at_another_T(tmp_path, capsys):
     rep = json.loads(capsys.readouterr().out)
     assert rep["filter"] == "design" and rep["provenance"]["runs"] == 2
     # the same design run from Python gives the same numbers (identity)
-    d = hn.load_design(path)
+    d = sun2011.load_design(path)
     assert d.gamma == saved["gamma"]
     with pytest.raises(hn.InputError, match="T = 0.1 s"):
-        hn.load_design(path, scenario=hn.Scenario(dt=1.0))
+        sun2011.load_design(path, scenario=sun2011.Scenario(dt=1.0))
     edited = json.loads(path.read_text())
     edited["system"]["B"][0][0] *= 2
     path.write_text(json.dumps(edited))
     with pytest.raises(hn.InputError, match="fingerprint"):
-        hn.load_design(path)
+        sun2011.load_design(path)
 
 
 @pytest.mark.parametrize("bad", ["", "a_file", "a_file/sub"])

@@ -12,7 +12,7 @@ import jsonschema
 import pytest
 import yaml
 
-from hinfnav.core.provenance import git_commit, package_version, provenance
+from hinfnav.io.provenance import git_commit, package_version, provenance
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import hinfnav as hn
+from hinfnav.papers import sun2011
 from hinfnav.analysis.norms import hinf_norm_bisection
 from hinfnav.core.exceptions import InfeasibleLMIError, InputError, UnstablePlantError
 from hinfnav.design.polytopic import error_coordinates
@@ -98,8 +99,8 @@ def test_ordering_pdl_quadratic_norm_bounded_at_10pct():
 
 
 def test_sun2011_as_a_polytope_beside_corollary1():
-    model = hn.Scenario().design_model(0.05)
-    cor1 = hn.design_for_scenario(None, 0.05)
+    model = sun2011.Scenario().design_model(0.05)
+    cor1 = sun2011.design_for_scenario(None, 0.05)
     # F = diag(q, 0, q, d, d, 0) with q, d ∈ [−1, 1] (uncertainty_F): two parameters, four vertices
     poly = PolytopicSystem.from_norm_bounded(model, groups=[[0, 2], [3, 4]])
     assert poly.n_vertices == 4

@@ -15,6 +15,7 @@ import scipy.linalg
 from filterpy.hinfinity import HInfinityFilter
 
 import hinfnav as hn
+from hinfnav.papers import sun2011
 from hinfnav.analysis import max_admissible_theta, steady_state_hinf
 from hinfnav.estimators import build_estimator
 from hinfnav.estimators.recursive_hinf import RecursiveHInfinityFilter
@@ -153,7 +154,7 @@ def test_theta_zero_on_the_chaser_sits_at_the_open_loop_kalman_limit(short_scena
     # stationary error at θ = 0 = the predicted Kalman limit without maneuver (the filter is told the thrust,
     # so its error obeys the open-loop model): 0.0802 m, 0.0224 m/s per axis (hinfnav.papers.sun2011.limits)
     st = theta_study(short_scenario, fractions=(0.0, 0.9), runs=2)
-    kl = hn.kalman_limit(short_scenario, maneuver=False)
+    kl = sun2011.kalman_limit(short_scenario, maneuver=False)
     assert st.pos_m_stat[0] == pytest.approx(np.sqrt(np.mean(kl.pos_m_predicted**2)), rel=1e-9)
     assert st.vel_mps_stat[0] == pytest.approx(np.sqrt(np.mean(kl.vel_mps_predicted**2)), rel=1e-9)
     assert st.vel_mps_stat[1] > st.vel_mps_stat[0]  # θ > 0 gives up accuracy in the mean-square sense

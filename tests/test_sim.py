@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from hinfnav import InputError, LTIFilter, Scenario, make_estimator, published_filter, rms_error, simulate
+from hinfnav import InputError, LTIFilter, rms_error, simulate
+from hinfnav.papers.sun2011 import Scenario, make_estimator, published_filter
 from hinfnav.papers.sun2011 import pos_vel
 from hinfnav.sim import simulate_truth
 from hinfnav.systems import measurement_matrix

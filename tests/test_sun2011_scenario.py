@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from hinfnav import InputError, Scenario, infer_sampling_time, published_filter
+from hinfnav import InputError
+from hinfnav.papers.sun2011 import Scenario, infer_sampling_time, published_filter
 from hinfnav.core import spectral_radius
 from hinfnav.sim import TruthModel
 from hinfnav.systems import LinearMeasurement, LinearSystem, measurement_matrix

@@ -17,7 +17,7 @@ import hinfnav
 
 #: The subpackages (and modules) whose ``__all__`` is walked, besides ``hinfnav.__all__``.
 SUBPACKAGES = (
-    "systems", "noise", "analysis", "lmi", "design", "estimators", "control", "sim", "metrics",
+    "systems", "noise", "analysis", "lmi", "io", "design", "estimators", "control", "sim", "metrics",
     "plotting", "campaign",
 )
 

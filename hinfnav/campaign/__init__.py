@@ -13,49 +13,48 @@ registers its scenario (``from hinfnav.campaign.registry import
 register_scenario``) loads neither pandas nor Dask; they come with the runner.
 """
 
-import importlib
+from typing import TYPE_CHECKING
 
-#: Public name -> the module (relative to this package) it comes from.
-_EXPORTS = {
-    "register_scenario": "registry",
-    "registered_scenarios": "registry",
-    "scenario_entry": "registry",
-    "scenario_parameters": "registry",
-    "condition_parameters": "registry",
-    "build_scenario": "registry",
-    "load_providers": "registry",
-    "PROVIDER_GROUP": "registry",
-    "providers": "registry",
-    "Campaign": "spec",
-    "Cell": "spec",
-    "load_campaign": "spec",
-    "canonical": "spec",
-    "digest": "spec",
-    "LIMITS": "spec",
-    "CellAccumulator": "stats",
-    "group_summary": "stats",
-    "rms_interval": "stats",
-    "results_table": "table",
-    "STATISTICS": "table",
-    "run_campaign": "runner",
-    "read_campaign": "runner",
-    "campaign_client": "runner",
-    "run_unit": "runner",
-    "campaign_units": "runner",
-    "clear_cache": "runner",
-    "SERIAL": "runner",
-}
+from ..core.lazy import lazy_exports
 
-__all__ = list(_EXPORTS)
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .registry import (
+        build_scenario, condition_parameters, load_providers, PROVIDER_GROUP, providers, register_scenario,
+        registered_scenarios, scenario_entry, scenario_parameters,
+    )
+    from .spec import Campaign, canonical, Cell, digest, LIMITS, load_campaign
+    from .stats import CellAccumulator, group_summary, rms_interval
+    from .table import results_table, STATISTICS
+    from .runner import campaign_client, campaign_units, clear_cache, read_campaign, run_campaign, run_unit, SERIAL
 
+__all__ = [
+    "register_scenario",
+    "registered_scenarios",
+    "scenario_entry",
+    "scenario_parameters",
+    "condition_parameters",
+    "build_scenario",
+    "load_providers",
+    "PROVIDER_GROUP",
+    "providers",
+    "Campaign",
+    "Cell",
+    "load_campaign",
+    "canonical",
+    "digest",
+    "LIMITS",
+    "CellAccumulator",
+    "group_summary",
+    "rms_interval",
+    "results_table",
+    "STATISTICS",
+    "run_campaign",
+    "read_campaign",
+    "campaign_client",
+    "run_unit",
+    "campaign_units",
+    "clear_cache",
+    "SERIAL",
+]
 
-def __getattr__(name):
-    if name in _EXPORTS:
-        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = lazy_exports(__name__)

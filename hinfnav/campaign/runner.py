@@ -46,9 +46,9 @@ import numpy as np
 from tqdm import tqdm
 
 from ..core.exceptions import HinfnavError, InputError
-from ..core.outputs import MARKER, check_output_dir, output_lock, to_json
-from ..core.progress import bar_disabled
-from ..core.provenance import package_version
+from ..io.outputs import MARKER, check_output_dir, output_lock, to_json
+from ..io.progress import bar_disabled
+from ..io.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
 from ..metrics.consistency import NIS_KEYS, initial_scale, warn_if_diverged
 from ..sim.montecarlo import check_measurement_match

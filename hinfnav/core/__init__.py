@@ -1,11 +1,12 @@
 """Core layer: exceptions, input validation and small linear-algebra helpers.
 
-Imports nothing from the rest of the package. The linear-algebra helpers
-(which load scipy) are loaded on first use, so that the command line, which
-needs only the exceptions, starts fast.
+Imports nothing from the rest of the package, and writes no file (file I/O is
+the :mod:`hinfnav.io` layer). The linear-algebra helpers (which load scipy) are
+loaded on first use (PEP 562, :mod:`hinfnav.core.lazy`), so that the command
+line, which needs only the exceptions, starts fast.
 """
 
-import importlib
+from typing import TYPE_CHECKING
 
 from .exceptions import (
     CertificationError,
@@ -17,18 +18,11 @@ from .exceptions import (
     SynthesisError,
     UnstablePlantError,
 )
+from .lazy import lazy_exports
 from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, as_positive, as_real, as_vector
 
-_LAZY = {"as_covariance": "linalg", "discretize": "linalg", "spectral_radius": "linalg", "sym": "linalg"}
-
-
-def __getattr__(name):
-    if name not in _LAZY:
-        raise AttributeError(f"module 'hinfnav.core' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .linalg import as_covariance, discretize, spectral_radius, sym
 
 __all__ = [
     "HinfnavError",
@@ -51,3 +45,5 @@ __all__ = [
     "sym",
     "discretize",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -4,17 +4,22 @@ Every filter returned is certified with :mod:`hinfnav.analysis`, whatever
 the solver reported.
 """
 
-from ..lmi.solve import SOLVERS, SolverOptions
-from .from_file import design_from_system_file, design_summary
-from .io import check_design_system, load_design, save_design, system_fingerprint
-from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
-from .compare import compare_uncertainty_models
-from .explain import small_gain_number
-from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
-from .recertify import recertify
-from .result import SynthesisResult
-from .robust_hinf import FORMS, synthesize
-from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
+from typing import TYPE_CHECKING
+
+from ..core.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from ..lmi.solve import SOLVERS, SolverOptions
+    from .from_file import design_from_system_file, design_summary
+    from .io import check_design_system, load_design, save_design, system_fingerprint
+    from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
+    from .compare import compare_uncertainty_models
+    from .explain import small_gain_number
+    from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
+    from .recertify import recertify
+    from .result import SynthesisResult
+    from .robust_hinf import FORMS, synthesize
+    from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
 __all__ = [
     "synthesize",
@@ -45,3 +50,5 @@ __all__ = [
     "design_summary",
     "compare_uncertainty_models",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

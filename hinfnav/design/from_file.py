@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..core.provenance import provenance
+from ..io.provenance import provenance
 from ..core.validation import as_choice
 from ..systems.files import read_system_file
 from ..systems.polytopic import PolytopicSystem

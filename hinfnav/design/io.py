@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..core.exceptions import InputError
-from ..core.provenance import provenance
+from ..io.provenance import provenance
 from ..core.validation import as_path, check_new_file
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
 from ..systems.uncertain import UncertainSystem

@@ -4,19 +4,24 @@ Never imports the design or simulation layers: a designed filter comes in as
 matrices.
 """
 
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
-from .huber import HuberUpdate, huber_update
-from .adaptive import RateAdaptive, StrongTracking
-from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
-from .extended_state import ExtendedStateKalmanFilter
-from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
-from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
-from .huber_filter import HuberCorrection, HuberFilter
-from .recursive_hinf import RecursiveHInfinityFilter
-from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, StrongTrackingEKF
-from .lti import LTIFilter
-from .sigma_point import SigmaPointFilter
-from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
+from typing import TYPE_CHECKING
+
+from ..core.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs
+    from .huber import HuberUpdate, huber_update
+    from .adaptive import RateAdaptive, StrongTracking
+    from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
+    from .extended_state import ExtendedStateKalmanFilter
+    from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
+    from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
+    from .huber_filter import HuberCorrection, HuberFilter
+    from .recursive_hinf import RecursiveHInfinityFilter
+    from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, StrongTrackingEKF
+    from .lti import LTIFilter
+    from .sigma_point import SigmaPointFilter
+    from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
     "Estimator",
@@ -54,3 +59,5 @@ __all__ = [
     "registered_estimators",
     "estimator_entry",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

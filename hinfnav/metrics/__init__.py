@@ -1,31 +1,14 @@
 """Metrics layer: error statistics of simulated runs, for any state."""
 
-from .consistency import (
-    DIVERGENCE_FACTOR,
-    NEES_FACTOR,
-    NIS_KEYS,
-    ConsistencyAccumulator,
-    ConsistencyStatistics,
-    chi2_bounds,
-    consistency,
-    initial_scale,
-    normalized_squared,
-    warn_if_diverged,
-)
-from .errors import (
-    MonteCarloSummary,
-    axes_rms,
-    by_group,
-    convergence_time,
-    group_rms,
-    max_error,
-    monte_carlo_summary,
-    rms_error,
-    rms_per_run,
-    window_mask,
-)
-from .intervals import format_interval, mean_interval, t_half_width
-from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
+from typing import TYPE_CHECKING
+
+from ..core.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .consistency import DIVERGENCE_FACTOR, NEES_FACTOR, NIS_KEYS, ConsistencyAccumulator, ConsistencyStatistics, chi2_bounds, consistency, initial_scale, normalized_squared, warn_if_diverged
+    from .errors import MonteCarloSummary, axes_rms, by_group, convergence_time, group_rms, max_error, monte_carlo_summary, rms_error, rms_per_run, window_mask
+    from .intervals import format_interval, mean_interval, t_half_width
+    from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
 
 __all__ = [
     "window_mask",
@@ -55,3 +38,5 @@ __all__ = [
     "mean_interval",
     "format_interval",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

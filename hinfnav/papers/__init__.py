@@ -28,7 +28,7 @@ from pathlib import Path
 
 from ..core.exceptions import InputError
 from ..core.validation import check_keywords
-from ..core.outputs import MARKER, atomic_output_dir
+from ..io.outputs import MARKER, atomic_output_dir
 from . import attitude2018, benchmark, grace2010, shi2018, sun2011, yang2020
 
 __all__ = ["PAPERS", "SELECTIONS", "reproduce", "sun2011", "shi2018", "attitude2018", "yang2020", "grace2010", "benchmark"]
@@ -62,7 +62,7 @@ def reproduce(paper="papers", out_dir="results", **options):
 
     ``out_dir`` is checked before any work; everything is written into a
     temporary folder beside it, which replaces it only when every paper has
-    finished (:func:`hinfnav.core.outputs.atomic_output_dir`): an interrupted
+    finished (:func:`hinfnav.io.outputs.atomic_output_dir`): an interrupted
     run leaves the previous folder as it was, and a second run into the same
     folder is refused while the first is writing. Redoing one paper keeps the
     other papers' sub-folders.

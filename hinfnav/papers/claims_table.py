@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 
 from ..core.exceptions import InputError
-from ..core.outputs import to_json
+from ..io.outputs import to_json
 
 __all__ = ["CLAIM_COLUMNS", "claims_rows", "format_claims_table", "write_claims_table"]
 

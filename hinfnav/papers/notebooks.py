@@ -11,7 +11,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
-from ..core.progress import bar_disabled
+from ..io.progress import bar_disabled
 
 __all__ = ["NOTEBOOK_DIR", "run_notebooks", "sequence_parameter"]
 

@@ -18,7 +18,7 @@ def save_figure(fig: Figure, out_dir: str | os.PathLike[str], name: str, provena
                 formats: Sequence[str] = ("png", "pdf"), dpi: int = 130) -> list[Path]:
     """Save ``fig`` as ``out_dir/name.<ext>`` for each format; return the paths.
 
-    The provenance dict (see :func:`hinfnav.core.provenance.provenance`) goes into
+    The provenance dict (see :func:`hinfnav.io.provenance.provenance`) goes into
     the PNG ``Description`` and the PDF ``Subject``, the figure's title into ``Title``.
     """
     prov = provenance or {}

@@ -1,8 +1,13 @@
 """Simulation layer: open-loop truth, closed loop, Monte Carlo with seeding and batching."""
 
-from .closed_loop import simulate_closed_loop
-from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate, simulate_batches
-from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
+from typing import TYPE_CHECKING
+
+from ..core.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
+    from .closed_loop import simulate_closed_loop
+    from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate, simulate_batches
+    from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
 
 __all__ = [
     "TruthModel",
@@ -18,3 +23,5 @@ __all__ = [
     "noise_models",
     "draw_noise",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

@@ -18,7 +18,7 @@ from tqdm import tqdm
 
 from ..control.feedback import LinearFeedback
 from ..core.exceptions import InputError
-from ..core.progress import bar_disabled
+from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
 from .montecarlo import SimulationResult, resolve_estimator
 from .truth import child_rngs, draw_noise, noise_models, scenario_truth_model

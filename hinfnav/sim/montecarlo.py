@@ -21,14 +21,14 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
-from ..core.progress import bar_disabled
+from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
-from ..design.result import SynthesisResult
 from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator
 from .truth import scenario_truth_model, simulate_truth
 
 if TYPE_CHECKING:
+    from ..design.result import SynthesisResult
     from ..noise import NoiseModel
     from ..systems.measurements import MeasurementModel
     from .truth import Truth
@@ -92,15 +92,19 @@ def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: An
     """
     if isinstance(estimator, str):
         return build_estimator(estimator, scenario)
-    if isinstance(estimator, SynthesisResult):
-        if not hasattr(scenario, "estimator_from_design"):
-            raise InputError(f"this scenario ({type(scenario).__name__}) cannot run a synthesized design directly")
-        return scenario.estimator_from_design(estimator)
     if estimator is None:
         raise InputError("estimator must be given (an Estimator or a registered filter name such as 'published')")
-    if not isinstance(estimator, Estimator):
-        raise InputError(f"estimator must be a hinfnav Estimator or a filter name; got {type(estimator).__name__}")
-    return estimator
+    if isinstance(estimator, Estimator):
+        return estimator
+    # Anything else must be a design the scenario can run; the scenario checks its type (not imported
+    # here, so that the simulation layer loads neither the design layer nor python-control).
+    if hasattr(scenario, "estimator_from_design"):
+        try:
+            return scenario.estimator_from_design(estimator)
+        except InputError as err:
+            raise InputError(f"estimator: {err}") from err
+    raise InputError(f"estimator must be a hinfnav Estimator or a filter name (this scenario, {type(scenario).__name__}, "
+                     f"cannot run a synthesized design directly); got {type(estimator).__name__}")
 
 
 def check_measurement_match(estimator: Estimator, measurement: MeasurementModel | None) -> None:

@@ -116,7 +116,7 @@ def scenario_truth_model(scenario: Any, conditions: dict[str, Any]) -> TruthMode
     """
     build = getattr(scenario, "truth_model", None)
     if not callable(build) or not hasattr(scenario, "xhat0"):
-        raise InputError(f"scenario must offer truth_model(**conditions) and xhat0 (such as hinfnav.Scenario); "
+        raise InputError(f"scenario must offer truth_model(**conditions) and xhat0 (such as a paper's Scenario, hinfnav.papers.<key>.Scenario); "
                          f"got {type(scenario).__name__}")
     try:
         params = inspect.signature(build).parameters.values()

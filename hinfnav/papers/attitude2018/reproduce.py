@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ...core.outputs import to_json
+from ...io.outputs import to_json
 from ...core.validation import as_int_at_least
 from ..notebooks import run_notebooks
 from .chaser import chaser_study, format_chaser_table, plot_chaser

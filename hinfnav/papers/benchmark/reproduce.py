@@ -7,8 +7,8 @@ from tqdm import tqdm
 
 from ...campaign.runner import run_campaign
 from ...core.exceptions import InputError
-from ...core.outputs import write_json
-from ...core.provenance import provenance
+from ...io.outputs import write_json
+from ...io.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...plotting.save import save_figure
 from ..notebooks import run_notebooks

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...core.outputs import to_json, write_json
-from ...core.provenance import provenance
+from ...io.outputs import to_json, write_json
+from ...io.provenance import provenance
 from ...core.validation import as_int_at_least, as_seed
 from ...plotting.save import save_figure
 from ..notebooks import run_notebooks

@@ -20,7 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...core.progress import bar_disabled
+from ...io.progress import bar_disabled
 from ...core.validation import as_int_at_least
 from ..notebooks import run_notebooks
 from .calibration import riccati_accuracy

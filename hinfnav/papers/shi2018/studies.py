@@ -24,7 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...core.progress import bar_disabled
+from ...io.progress import bar_disabled
 from ...core.validation import as_choice, as_int_at_least
 from ...estimators.huber_filter import HuberFilter
 from ...metrics.errors import window_mask

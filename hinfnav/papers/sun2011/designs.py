@@ -27,8 +27,8 @@ from ...analysis.norms import channel_norms, hinf_norm
 from ...analysis.observer import observer_form
 from ...core.exceptions import InputError, UnstablePlantError
 from ...core.linalg import spectral_radius
-from ...core.progress import bar_disabled
-from ...core.provenance import provenance
+from ...io.progress import bar_disabled
+from ...io.provenance import provenance
 from ...core.validation import as_int_at_least, as_nonnegative, check_keywords
 from ...design import io as design_io
 from ...design.result import SynthesisResult

@@ -10,7 +10,7 @@ by the command it names.
 import numpy as np
 
 from ...core.exceptions import InputError
-from ...core.provenance import provenance
+from ...io.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...metrics.intervals import mean_interval
 from ...metrics.streaming import monte_carlo_statistics

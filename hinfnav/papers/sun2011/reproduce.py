@@ -7,9 +7,9 @@ from tqdm import tqdm
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_seed
-from ...core.outputs import to_json, write_json
-from ...core.progress import bar_disabled
-from ...core.provenance import provenance
+from ...io.outputs import to_json, write_json
+from ...io.progress import bar_disabled
+from ...io.provenance import provenance
 from ...metrics.errors import rms_per_run
 from ...plotting.save import save_figure
 from ..notebooks import run_notebooks

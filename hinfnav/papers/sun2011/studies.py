@@ -12,7 +12,7 @@ from ...analysis.observer import observer_form
 from ...core.exceptions import InputError
 from ...core.linalg import spectral_radius
 from ...core.validation import as_choice
-from ...core.progress import bar_disabled
+from ...io.progress import bar_disabled
 from ...metrics.errors import axes_rms, max_error, rms_error, rms_per_run
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth

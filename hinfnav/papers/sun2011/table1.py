@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_seed
-from ...core.progress import bar_disabled
+from ...io.progress import bar_disabled
 from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
 from ...metrics.intervals import format_interval, mean_interval

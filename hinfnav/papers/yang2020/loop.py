@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from ...core.progress import bar_disabled
+from ...io.progress import bar_disabled
 from ...core.validation import as_choice, as_int_at_least
 from ...sim.truth import child_rngs
 from .constants import ACCELEROMETER_RANGE, D_TRANS, K_TRANS, M_SC, M_TM

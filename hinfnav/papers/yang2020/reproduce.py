@@ -17,10 +17,10 @@ import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...core.outputs import to_json as _to_json
-from ...core.outputs import write_json
-from ...core.progress import bar_disabled
-from ...core.provenance import provenance
+from ...io.outputs import to_json as _to_json
+from ...io.outputs import write_json
+from ...io.progress import bar_disabled
+from ...io.provenance import provenance
 from ...core.validation import as_int_at_least
 from ...plotting.save import save_figure
 from ..claims_table import write_claims_table

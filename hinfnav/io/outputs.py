@@ -11,17 +11,21 @@ previous complete folder untouched (and a ``.tmp`` folder that the next run
 removes); no file ever mixes two runs.
 """
 
+from __future__ import annotations
+
 import contextlib
 import json
 import math
 import os
 import shutil
+from collections.abc import Iterable, Iterator
 from pathlib import Path
+from typing import Any
 
 import filelock
 import numpy as np
 
-from .exceptions import InputError
+from ..core.exceptions import InputError
 
 __all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "write_json"]
 
@@ -32,7 +36,7 @@ MARKER = ".hinfnav-output"
 _LOCK_WAIT_S = 0.5
 
 
-def check_output_dir(path, name="out"):
+def check_output_dir(path: str | os.PathLike | None, name: str = "out") -> Path:
     """Validate an output folder before any work; return it as an absolute :class:`Path`."""
     if path is None or str(path).strip() == "":
         raise InputError(f"{name} must name a folder; got an empty path")
@@ -58,14 +62,14 @@ def check_output_dir(path, name="out"):
     return target
 
 
-def lock_path(target):
+def lock_path(target: str | os.PathLike) -> Path:
     """The lock file of the output folder ``target``: ``.<name>.lock`` beside it."""
     target = Path(target)
     return target.parent / f".{target.name}.lock"
 
 
 @contextlib.contextmanager
-def output_lock(target, name="out"):
+def output_lock(target: str | os.PathLike, name: str = "out") -> Iterator[None]:
     """Context manager: hold the OS-level lock of the output folder ``target`` (another holder → InputError).
 
     The lock is an advisory ``flock``/``LockFileEx`` lock taken through :mod:`filelock` on
@@ -91,7 +95,7 @@ def output_lock(target, name="out"):
 
 
 @contextlib.contextmanager
-def atomic_output_dir(path, *, keep=(), name="out"):
+def atomic_output_dir(path: str | os.PathLike, *, keep: Iterable[str] = (), name: str = "out") -> Iterator[Path]:
     """Context manager: yield a temporary folder that replaces ``path`` when the block succeeds.
 
     Parameters
@@ -126,7 +130,7 @@ def atomic_output_dir(path, *, keep=(), name="out"):
             shutil.rmtree(tmp, ignore_errors=True)
 
 
-def to_json(obj, *, strict=False):
+def to_json(obj: Any, *, strict: bool = False) -> Any:
     """A JSON-ready copy of ``obj``: numpy arrays and scalars become lists and Python numbers.
 
     ``strict=True`` also turns NaN and infinities into None (null), which
@@ -145,7 +149,7 @@ def to_json(obj, *, strict=False):
     return obj
 
 
-def write_json(path, obj):
+def write_json(path: str | os.PathLike, obj: Any) -> Any:
     """Write ``to_json(obj)`` to ``path`` (indented, newline at the end); return the written object."""
     data = to_json(obj)
     Path(path).write_text(json.dumps(data, indent=2) + "\n")

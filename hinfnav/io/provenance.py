@@ -5,6 +5,8 @@ designs and results tables; figures carry the same in their metadata.
 Library versions are read from the installed distributions (no import).
 """
 
+from __future__ import annotations
+
 import datetime
 import platform
 import subprocess
@@ -17,11 +19,11 @@ __all__ = ["provenance", "package_version", "git_commit", "LIBRARIES"]
 LIBRARIES = ("numpy", "scipy", "cvxpy", "control", "filterpy", "matplotlib")
 
 
-def _source_root():
+def _source_root() -> Path:
     return Path(__file__).resolve().parents[2]
 
 
-def package_version():
+def package_version() -> str:
     """hinfnav's version: from git in a source checkout, else the installed distribution's.
 
     In a checkout the version is recomputed from the repository (setuptools-scm: the last tag
@@ -42,7 +44,7 @@ def package_version():
         return "unknown"
 
 
-def git_commit():
+def git_commit() -> str | None:
     """The commit of the source tree (with ``+dirty`` if it has uncommitted changes), or None."""
     root = _source_root()
     if not (root / ".git").exists():
@@ -58,7 +60,7 @@ def git_commit():
         return None
 
 
-def provenance(**extra):
+def provenance(**extra: object) -> dict:
     """JSON-ready provenance: ``hinfnav``, ``commit``, ``date_utc``, ``python``, library versions, and ``extra``.
 
     Parameters

@@ -3,7 +3,7 @@
 __all__ = ["bar_disabled"]
 
 
-def bar_disabled(progress):
+def bar_disabled(progress: bool | None) -> bool | None:
     """The ``disable`` argument of tqdm: off when not asked for, and off when output is not a terminal.
 
     tqdm's ``disable=None`` turns the bar off on a non-TTY stream, so a log
