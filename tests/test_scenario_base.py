@@ -61,3 +61,17 @@ def test_rms_window_is_one_name_and_the_old_shi2018_name_still_works_with_a_warn
         sc = cls()
         start, end = sc.rms_window_s
         assert 0 <= start < end <= sc.duration_s
+
+
+def test_the_adaptive_filters_memory_is_memory_steps_and_window_still_works_with_a_warning():
+    # issue 23: ``window`` of the rate-adaptive filters is m, a number of steps, not a (start, end) window
+    from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
+    from hinfnav.papers.attitude2018.filters import build_aaekf
+
+    sc = AttitudeScenario(orbits=0.25)
+    assert build_aaekf(sc).memory_steps == 60  # paper 002's default m (constants.DEFAULT_AA)
+    assert build_aaekf(sc, memory_steps=7).memory_steps == 7
+    with pytest.warns(DeprecationWarning, match="window is deprecated, use memory_steps"):
+        assert build_aaekf(sc, window=9).memory_steps == 9
+    with pytest.raises(InputError, match="memory_steps"):
+        build_aaekf(sc, memory_steps=0)
