@@ -9,6 +9,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from PIL import Image  # matplotlib's own dependency (it writes the PNG files)
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -60,8 +62,6 @@ def read_provenance(path: str | os.PathLike[str]) -> dict[str, Any] | None:
     if suffix not in (".png", ".pdf") or not path.is_file():
         raise InputError(f"path must be a PNG or PDF file written by save_figure; got {path}")
     if suffix == ".png":
-        from PIL import Image
-
         with Image.open(path) as img:
             text = img.text.get("Description")
     else:
