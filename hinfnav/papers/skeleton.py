@@ -33,11 +33,11 @@ from .notebooks import check_notebooks, run_notebooks
 __all__ = ["Reproduction", "atomic_write_text"]
 
 
-def atomic_write_text(path, text):
+def atomic_write_text(path, text, encoding="utf-8"):
     """Write ``text`` to ``path`` through a temporary file beside it and :func:`os.replace` (never half a file)."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
+    tmp.write_text(text, encoding=encoding)
     os.replace(tmp, path)
     return path
 
