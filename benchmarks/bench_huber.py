@@ -42,7 +42,7 @@ def main(argv=None):
         lw, _, _ = _time(lambda: [est.estimate(truth.y[r:r + 1], truth.u[r:r + 1], sc.xhat0, keep_covariance=False)
                                   for r in range(n)])
         loop = lw * args.runs / n
-        m = sc.time >= sc.window_s[0]
+        m = sc.time >= sc.rms_window_s[0]
         pos = float(np.sqrt(np.mean((truth.x - hist.xhat)[:, m, :3] ** 2)))
         print(f"{est.name:8}{wall:18.2f}{cpu:17.2f}{loop:25.1f}{loop / wall:8.1f}{pos:13.3f}")
     print("target: HBF batched over 1000 runs x 2500 steps under 15 s on 2 cores")

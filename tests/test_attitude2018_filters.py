@@ -80,11 +80,11 @@ def test_fading_factors_by_hand():
 
 
 def test_rate_window_and_adapted_density():
-    window = np.zeros((4, 1, 2))
+    history = np.zeros((4, 1, 2))
     for k in range(6):  # a ramp of slope (2, −1) per step, ring buffer of m + 1 = 4
-        window[k % 4, 0] = [2.0 * k, -1.0 * k]
-    np.testing.assert_allclose(input_rate(window, 6, 3, 0.5), [[4.0, -2.0]])  # (β̂_k − β̂_{k−m})/(mΔt)
-    np.testing.assert_allclose(input_rate(window, 2, 3, 0.5), [[4.0, -2.0]])  # fewer than m steps: the span available
+        history[k % 4, 0] = [2.0 * k, -1.0 * k]
+    np.testing.assert_allclose(input_rate(history, 6, 3, 0.5), [[4.0, -2.0]])  # (β̂_k − β̂_{k−m})/(mΔt)
+    np.testing.assert_allclose(input_rate(history, 2, 3, 0.5), [[4.0, -2.0]])  # fewer than m steps: the span available
     q = rate_adapted_density(np.array([1e-16, 1e-16]), np.array([[1e-9, 1e-7]]), 1e8, 1.0)
     np.testing.assert_allclose(q, [[1e-16, 1e-14]])  # max(1, (εκ)²) Q0
 

@@ -165,7 +165,7 @@ def test_campaign_cell_carries_consistency():
 
 def _outlier_track():
     """Shi 2018's track (range/azimuth/elevation sensor) cut to 200 s, with 7 % outliers of 10 σ."""
-    sc = ShiScenario().replace(duration_s=200.0, maneuver_time_s=100.0, window_s=(100.0, 200.0))
+    sc = ShiScenario().replace(duration_s=200.0, maneuver_time_s=100.0, rms_window_s=(100.0, 200.0))
     # the class of the registered ekf_augmented_thrust_st (ρ = 0.95, β = 1), on this track: the unknown input
     # (acceleration, m/s²) as a random walk of density 1e-8 (m/s²)²/s, initial σ 1e-3 m/s²
     kw = dict(Q_input=1e-8 * np.eye(3), P0=sc.P0, P0_input=1e-6 * np.eye(3))
@@ -177,7 +177,7 @@ def test_strong_tracking_on_outliers_is_flagged_diverged():
     sc, st, plain = _outlier_track()
     noise = ContaminatedNoise(eps=0.07, ratio=10.0)  # (1 − ε) N(0, σ²) + ε N(0, (10σ)²): 7 % outliers
     with pytest.warns(FilterDivergenceWarning, match="strong_tracking.*initial error scale"), np.errstate(all="ignore"):
-        stats = monte_carlo_statistics(sc, st, windows={"late": sc.window_s}, runs=4, seed=0, measurement_noise=noise)
+        stats = monte_carlo_statistics(sc, st, windows={"late": sc.rms_window_s}, runs=4, seed=0, measurement_noise=noise)
     s = stats.consistency_summary
     # the failure of the issue: the estimates stay finite while the error runs away (here beyond 1e90 m)
     assert np.all(np.isfinite(stats["late"].max_abs)) and stats["late"].max_abs[:3].max() > 1e90
@@ -185,7 +185,7 @@ def test_strong_tracking_on_outliers_is_flagged_diverged():
     # the same data without strong tracking: no flag (no false alarm from the outliers themselves)
     with warnings.catch_warnings():
         warnings.simplefilter("error", FilterDivergenceWarning)
-        ref = monte_carlo_statistics(sc, plain, windows={"late": sc.window_s}, runs=4, seed=0, measurement_noise=noise)
+        ref = monte_carlo_statistics(sc, plain, windows={"late": sc.rms_window_s}, runs=4, seed=0, measurement_noise=noise)
     assert not ref.consistency_summary["diverged"] and ref["late"].max_abs[:3].max() < 1e3
 
 

@@ -17,7 +17,7 @@ from hinfnav.papers import sun2011
 from hinfnav.papers.shi2018 import EKF, HBF, Scenario
 from hinfnav.systems.measurements import ConvertedPosition, RangeAzimuthElevation
 
-SHORT = Scenario(duration_s=60.0, maneuver_time_s=30.0, window_s=(20.0, 60.0))
+SHORT = Scenario(duration_s=60.0, maneuver_time_s=30.0, rms_window_s=(20.0, 60.0))
 
 
 @pytest.fixture(scope="module")

@@ -21,7 +21,7 @@ from hinfnav.papers.shi2018 import (
 )
 from hinfnav.papers.shi2018.reproduce import _run_jobs
 
-TINY = Scenario(duration_s=40.0, maneuver_time_s=20.0, window_s=(10.0, 40.0))
+TINY = Scenario(duration_s=40.0, maneuver_time_s=20.0, rms_window_s=(10.0, 40.0))
 
 
 @pytest.fixture(scope="module")

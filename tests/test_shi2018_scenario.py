@@ -42,7 +42,7 @@ def test_orbit_and_closed_relative_orbit():
 def test_maneuver_is_away_along_x_and_only_adds_its_response():
     # Identity: the maneuver truth is the no-maneuver truth (same seed, same draws) plus
     # Phi^(k - k_m) dv; readings before the maneuver are identical.
-    sc = Scenario(duration_s=40.0, maneuver_time_s=20.0, window_s=(10.0, 40.0))
+    sc = Scenario(duration_s=40.0, maneuver_time_s=20.0, rms_window_s=(10.0, 40.0))
     dv = sc.maneuver_dv()
     assert dv[3] == pytest.approx(0.1) and np.count_nonzero(dv) == 1  # x(20 s) > 0: away = +x
     a = sc.simulate_truth(runs=3, seed=5)
@@ -59,7 +59,7 @@ def test_maneuver_is_away_along_x_and_only_adds_its_response():
 
 
 def test_generic_simulate_runs_the_scenario():
-    sc = Scenario(duration_s=40.0, maneuver_time_s=20.0, window_s=(10.0, 40.0))
+    sc = Scenario(duration_s=40.0, maneuver_time_s=20.0, rms_window_s=(10.0, 40.0))
     res = hn.simulate(sc, "ekf_converted", runs=2, seed=1)
     direct = sc.simulate_truth(runs=2, seed=1)
     np.testing.assert_array_equal(res.x, direct.x)  # same seed convention as simulate_truth
@@ -102,7 +102,7 @@ def test_ekf_error_sits_on_the_kalman_limit(assert_rms_matches):
     truth = SC.simulate_truth(runs=24, seed=2)
     hist = EKF(SC).estimate(truth.y, truth.u, SC.xhat0, keep_covariance=False)
     lim = riccati_accuracy(SC)
-    assert_rms_matches(truth.x - hist.xhat, SC.time, SC.window_s, lim.axes)
+    assert_rms_matches(truth.x - hist.xhat, SC.time, SC.rms_window_s, lim.axes)
 
 
 def test_bad_settings_name_the_parameter():
@@ -111,7 +111,7 @@ def test_bad_settings_name_the_parameter():
     with pytest.raises(InputError, match="maneuver_time_s"):
         Scenario(maneuver_time_s=2000.0)
     with pytest.raises(InputError, match="window_s"):
-        Scenario(window_s=(500.0, 100.0))
+        Scenario(rms_window_s=(500.0, 100.0))
     with pytest.raises(InputError, match="P0"):
         Scenario(P0=-np.eye(6))
     with pytest.raises(InputError, match="x0"):

@@ -38,6 +38,7 @@ passed κ uses the steps available.
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -125,12 +126,12 @@ def fade(PhiPPhiT, lam):
     return s[..., :, None] * PhiPPhiT * s[..., None, :]
 
 
-def input_rate(window, count, m, dt):
+def input_rate(history, count, m, dt):
     """Rate of the augmented states (R1) from a ring buffer of estimates.
 
     Parameters
     ----------
-    window : ndarray, shape (m + 1, runs, n_aug)
+    history : ndarray, shape (m + 1, runs, n_aug)
         The last estimates, slot ``j % (m + 1)`` holding step j.
     count : int
         Number of estimates pushed so far (the newest is step count − 1).
@@ -144,10 +145,10 @@ def input_rate(window, count, m, dt):
         before two estimates exist.
     """
     if count < 2:
-        return np.zeros(window.shape[1:])
+        return np.zeros(history.shape[1:])
     span = min(m, count - 1)
-    newest = window[(count - 1) % (m + 1)]
-    oldest = window[(count - 1 - span) % (m + 1)]
+    newest = history[(count - 1) % (m + 1)]
+    oldest = history[(count - 1 - span) % (m + 1)]
     return (newest - oldest) / (span * dt)
 
 
@@ -248,8 +249,9 @@ class RateAdaptive:
 
     Parameters
     ----------
-    window : int
-        m, the number of steps over which the rate is estimated (≥ 1).
+    memory_steps : int
+        m, the number of steps over which the rate is estimated (≥ 1). Called
+        ``window`` before issue 23 (still accepted, with a DeprecationWarning).
     epsilon : float or array_like, shape (runs,)
         Compression factor ε, s per unit of the augmented state (> 0); one
         value per run batches an ε sweep.
@@ -262,31 +264,35 @@ class RateAdaptive:
 
     data_dependent_covariance = True
 
-    def __init__(self, *args: Any, window: int = 60, epsilon: float = 1.0, floor: float = 1.0, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, memory_steps: int = 60, epsilon: float = 1.0, floor: float = 1.0,
+                 window: int | None = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        self.window = as_int_at_least("window", window, 1)
+        if window is not None:
+            warnings.warn("window is deprecated, use memory_steps (m, steps)", DeprecationWarning, stacklevel=2)
+            memory_steps = window
+        self.memory_steps = as_int_at_least("memory_steps", memory_steps, 1)
         self.epsilon = per_run_parameter("epsilon", epsilon, as_positive)
         self.floor = as_nonnegative("floor", floor)
         self._Q0_diag = np.diag(self.Q).copy()
 
     def process_noise(self, state: FilterState) -> tuple[NDArray[np.float64], dict[str, Any]]:
         extra = state.extra
-        kappa = input_rate(extra["rate_window"], extra["rate_count"], self.window, self.dt)
+        kappa = input_rate(extra["rate_history"], extra["rate_count"], self.memory_steps, self.dt)
         q = rate_adapted_density(self._Q0_diag, kappa, self.epsilon, self.floor)
         Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
         return Qd, {"q_used": q, "kappa_used": kappa}
 
     def _start(self, xhat0, P0, runs):
         state = super()._start(xhat0, P0, runs)
-        window = np.zeros((self.window + 1, runs, self.n_aug))
-        state.extra.update(rate_window=window, rate_count=0)
+        history = np.zeros((self.memory_steps + 1, runs, self.n_aug))
+        state.extra.update(rate_history=history, rate_count=0)
         return state
 
     def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
-        window = state.extra["rate_window"].copy()
+        history = state.extra["rate_history"].copy()
         count = state.extra["rate_count"]
-        window[count % (self.window + 1)] = self.augmented(x_post)
-        return {"rate_window": window, "rate_count": count + 1}
+        history[count % (self.memory_steps + 1)] = self.augmented(x_post)
+        return {"rate_history": history, "rate_count": count + 1}
 
     def step_diagnostics(self, state: FilterState) -> dict[str, Any]:
         out = super().step_diagnostics(state)

@@ -112,7 +112,7 @@ class AttitudeASTEKF(StrongTracking, AttitudeAEKF):
 class AttitudeAAEKF(RateAdaptive, AttitudeAEKF):
     """Augmented adaptive EKF (paper 002 §2.2): :class:`AttitudeAEKF` with ``Q(t_k) = Q(t₀) F[ε κ(t_k)]``.
 
-    Extra parameters ``window`` (m steps), ``epsilon`` (ε, s/(N·m)) and
+    Extra parameters ``memory_steps`` (m steps), ``epsilon`` (ε, s/(N·m)) and
     ``floor``; ``Q`` is Q(t₀). See :class:`~hinfnav.estimators.adaptive.RateAdaptive`.
     """
 

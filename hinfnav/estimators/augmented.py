@@ -287,7 +287,7 @@ class AugmentedInputSTKF(StrongTracking, AugmentedInputKF):
 
 
 class AugmentedInputAdaptiveKF(RateAdaptive, AugmentedInputKF):
-    """:class:`AugmentedInputKF` whose input noise follows the input's estimated rate (``window``, ``epsilon``, ``floor``)."""
+    """:class:`AugmentedInputKF` whose input noise follows the input's estimated rate (``memory_steps``, ``epsilon``, ``floor``)."""
 
     name = "augmented input adaptive kf"
 

@@ -8,11 +8,11 @@ module gives them ``id``, ``figure``, ``statistic``, ``number`` (ours) and
 import csv
 import io
 import json
-import os
 from pathlib import Path
 
 from ..core.exceptions import InputError
 from ..io.outputs import to_json
+from .skeleton import atomic_write_text
 
 __all__ = ["CLAIM_COLUMNS", "claims_rows", "format_claims_table", "write_claims_table"]
 
@@ -52,12 +52,6 @@ def format_claims_table(claims, title):
     return "\n".join(lines) + "\n"
 
 
-def _write_atomic(path, text):
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-
-
 def write_claims_table(claims, out_dir, title, name="claims"):
     """Write ``<name>.csv`` and ``<name>.md`` into ``out_dir`` (each atomically); returns their paths."""
     out = Path(out_dir)
@@ -68,6 +62,6 @@ def write_claims_table(claims, out_dir, title, name="claims"):
     for r in claims_rows(claims):
         writer.writerow({k: _cell(v) for k, v in r.items()})
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
-    _write_atomic(csv_path, buf.getvalue())
-    _write_atomic(md_path, format_claims_table(claims, title))
+    atomic_write_text(csv_path, buf.getvalue())
+    atomic_write_text(md_path, format_claims_table(claims, title))
     return csv_path, md_path

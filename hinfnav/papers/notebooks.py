@@ -1,8 +1,11 @@
 """Executing a paper's notebooks into an output folder: what ``reproduce(notebooks=True)`` does.
 
-Every paper's ``reproduce`` can also execute its chapter of the workbook (the
-notebooks whose names match its decade, e.g. ``1[0-9]_*.ipynb`` for Shi &
-Wang 2018) and write them, with their outputs, beside its figures.
+Every paper's ``reproduce`` can also execute its chapter of the workbook and
+write it, with its outputs, beside its figures. A chapter is the explicit
+tuple ``NOTEBOOKS`` of the paper's ``reproduce`` module (never a file-name
+pattern: each notebook belongs to exactly one paper, or to
+:data:`CROSS_PAPER`, which the primary paper runs), so ``reproduce --paper
+all --notebooks`` executes every notebook once.
 """
 
 import ast
@@ -13,20 +16,55 @@ from tqdm import tqdm
 from ..core.exceptions import InputError
 from ..io.progress import bar_disabled
 
-__all__ = ["NOTEBOOK_DIR", "run_notebooks", "sequence_parameter"]
+__all__ = ["CROSS_PAPER", "NOTEBOOK_DIR", "check_notebooks", "execute_notebook", "run_notebooks",
+           "sequence_parameter"]
 
 #: The repository's notebooks (next to the package in a source checkout).
 NOTEBOOK_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 
+#: Notebooks of no single paper (a reader's own system); the primary paper (sun2011, whose output is the
+#: folder's root) executes them after its own.
+CROSS_PAPER = ("80_your_own_system.ipynb",)
 
-def run_notebooks(out_dir, pattern, *, timeout=900, progress=True):
-    """Execute the notebooks of :data:`NOTEBOOK_DIR` matching ``pattern`` and write them into ``out_dir``.
+
+def execute_notebook(path, target, *, timeout=900):
+    """Execute the notebook ``path`` (in :data:`NOTEBOOK_DIR`, as a reader would) and write it to ``target``."""
+    import nbformat  # heavy optional libraries: only when notebooks are asked for
+    from nbclient import NotebookClient
+
+    nb = nbformat.read(path, as_version=4)
+    NotebookClient(nb, timeout=timeout, kernel_name="python3",
+                   resources={"metadata": {"path": str(NOTEBOOK_DIR)}}).execute()
+    nbformat.write(nb, target)
+    return Path(target)
+
+
+def check_notebooks(names):
+    """``names`` as a tuple of notebook file names that all exist in :data:`NOTEBOOK_DIR` (before any work).
+
+    Raises
+    ------
+    InputError
+        When ``names`` is not a sequence of names, or one is missing (an installed package has no
+        notebooks folder).
+    """
+    if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+        raise InputError(f"names must be a sequence of notebook file names; got {names!r}")
+    missing = [n for n in names if not (NOTEBOOK_DIR / n).is_file()]
+    if missing:
+        raise InputError(f"notebooks=True needs the repository's notebooks/ folder next to the package; "
+                         f"{', '.join(missing)} not in {NOTEBOOK_DIR}")
+    return tuple(names)
+
+
+def run_notebooks(out_dir, names, *, timeout=900, progress=True):
+    """Execute the notebooks ``names`` of :data:`NOTEBOOK_DIR` and write them into ``out_dir``.
 
     Parameters
     ----------
     out_dir : str or Path
-    pattern : str
-        Glob of the notebook names (``"[0-9][0-9]_*.ipynb"``: all of them).
+    names : sequence of str
+        File names (``"01_model_and_scenario.ipynb"``, …): a paper's ``NOTEBOOKS``.
     timeout : float
         Seconds a cell may run.
     progress : bool
@@ -39,23 +77,12 @@ def run_notebooks(out_dir, pattern, *, timeout=900, progress=True):
     Raises
     ------
     InputError
-        When no notebook matches (an installed package has no notebooks folder).
+        See :func:`check_notebooks`.
     """
-    import nbformat  # heavy optional libraries: only when notebooks are asked for
-    from nbclient import NotebookClient
-
-    paths = sorted(NOTEBOOK_DIR.glob(pattern)) if NOTEBOOK_DIR.is_dir() else []
-    if not paths:
-        raise InputError(f"notebooks=True needs the repository's notebooks/ folder next to the package; no {pattern} "
-                         f"in {NOTEBOOK_DIR}")
+    names = check_notebooks(names)
     written = []
-    for path in tqdm(paths, disable=bar_disabled(progress), desc="notebooks", unit="nb"):
-        nb = nbformat.read(path, as_version=4)
-        NotebookClient(nb, timeout=timeout, kernel_name="python3",
-                       resources={"metadata": {"path": str(NOTEBOOK_DIR)}}).execute()
-        target = Path(out_dir) / path.name
-        nbformat.write(nb, target)
-        written.append(target)
+    for name in tqdm(names, disable=bar_disabled(progress), desc="notebooks", unit="nb"):
+        written.append(execute_notebook(NOTEBOOK_DIR / name, Path(out_dir) / name, timeout=timeout))
     return written
 
 

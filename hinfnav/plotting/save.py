@@ -1,17 +1,27 @@
-"""Saving figures with their provenance in the file's metadata."""
+"""Saving figures with their provenance in the file's metadata, and reading it back."""
 
 from __future__ import annotations
 
 import json
 import os
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from PIL import Image  # matplotlib's own dependency (it writes the PNG files)
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["save_figure"]
+from ..core.exceptions import InputError
+
+__all__ = ["save_figure", "read_provenance"]
+
+#: The PDF Info entry holding the provenance, as matplotlib writes it: a literal string ``(...)``.
+_PDF_SUBJECT = re.compile(rb"/Subject \(((?:[^\\)]|\\.)*)\)", re.DOTALL)
+_PDF_ESCAPES = {b"n": b"\n", b"r": b"\r", b"t": b"\t", b"b": b"\b", b"f": b"\f", b"(": b"(", b")": b")",
+                b"\\": b"\\"}
 
 
 def save_figure(fig: Figure, out_dir: str | os.PathLike[str], name: str, provenance: Mapping[str, Any] | None = None, *,
@@ -34,3 +44,34 @@ def save_figure(fig: Figure, out_dir: str | os.PathLike[str], name: str, provena
         fig.savefig(path, dpi=dpi, metadata=meta.get(ext))
         paths.append(path)
     return paths
+
+
+def read_provenance(path: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The provenance dict :func:`save_figure` wrote into a PNG or PDF file, or None when it has none.
+
+    Reads the PNG ``Description`` text chunk (with Pillow, which matplotlib requires) or the PDF
+    ``/Subject`` entry of the document information dictionary.
+
+    Raises
+    ------
+    InputError
+        ``path`` is not a ``.png`` or ``.pdf`` file.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".png", ".pdf") or not path.is_file():
+        raise InputError(f"path must be a PNG or PDF file written by save_figure; got {path}")
+    if suffix == ".png":
+        with Image.open(path) as img:
+            text = img.text.get("Description")
+    else:
+        match = _PDF_SUBJECT.search(path.read_bytes())
+        text = None if match is None else re.sub(rb"\\(.)", lambda m: _PDF_ESCAPES.get(m.group(1), m.group(1)),
+                                                 match.group(1)).decode("latin-1")
+    if not text:
+        return None
+    try:
+        prov = json.loads(text)
+    except json.JSONDecodeError:
+        return None
+    return prov if isinstance(prov, dict) and prov else None

@@ -17,7 +17,7 @@ Documented choices (nothing tuned on the truth):
   the thrust's rate (the truth's largest is 93 N/s) → Q_F = 1000 N²/s.
 * The ASTEKF's and the AAEKF's base Q_F = Q_F/100 = 10 N²/s (paper 002's
   ratio between its ASTEKF and best-AEKF Q); ε such that Q_F(t₀)(ε ḟ_max)² =
-  Q_F: ε = 0.1 s/N (the rule used for the attitude AAEKF); window m = 50
+  Q_F: ε = 0.1 s/N (the rule used for the attitude AAEKF); memory m = 50 steps
   steps (5 s); ρ = 0.95, β = 1 (as for the attitude ASTEKF).
 * Initial thrust estimate 0 with σ = 3000 N (the order of Fig 6's largest
   thrust); the chaser state's P₀ and Q = BBᵀ, R = DDᵀ are Sun 2011's EKF's.
@@ -49,7 +49,7 @@ __all__ = [
     "Q_THRUST_BASE",
     "THRUST_EPSILON",
     "THRUST_RATE_MAX",
-    "THRUST_WINDOW",
+    "THRUST_MEMORY_STEPS",
     "WINDOWS",
     "ChaserStudy",
     "build_augmented_thrust",
@@ -69,8 +69,8 @@ Q_THRUST = THRUST_RATE_MAX**2 * 0.1
 Q_THRUST_BASE = Q_THRUST / 100.0
 #: Compression factor ε of the adaptive variant, s/N: Q_BASE (ε ḟ_max)² = Q_THRUST.
 THRUST_EPSILON = float(np.sqrt(Q_THRUST / Q_THRUST_BASE) / THRUST_RATE_MAX)
-#: Rate window m of the adaptive variant, steps (5 s at T = 0.1 s).
-THRUST_WINDOW = 50
+#: Memory m of the adaptive variant's rate estimate, steps (5 s at T = 0.1 s).
+THRUST_MEMORY_STEPS = 50
 #: Initial standard deviation of the thrust estimate, N.
 P0_THRUST_STD = 3000.0
 #: The two windows of the comparison, s: during the maneuver, after it.
@@ -92,7 +92,7 @@ def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_
     P0_input_std : float
         Initial σ of the thrust estimate, N.
     **options
-        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``window``, ``floor`` (adaptive).
+        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``memory_steps``, ``floor`` (adaptive).
 
     Returns
     -------
@@ -115,7 +115,7 @@ def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_
         options.setdefault("beta", 1.0)
         return AugmentedInputSTKF(system, meas, name=name, **kw, **options)
     options.setdefault("epsilon", THRUST_EPSILON)
-    options.setdefault("window", THRUST_WINDOW)
+    options.setdefault("memory_steps", THRUST_MEMORY_STEPS)
     return AugmentedInputAdaptiveKF(system, meas, name=name, **kw, **options)
 
 
@@ -229,7 +229,7 @@ def chaser_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, progress=Fa
         "epsilon_adaptive": _sweep(scenario, small, "adaptive", "epsilon", [0.03, 0.1, 0.3, 1.0, 3.0]),
     }
     settings = {"runs": runs, "sweep_runs": sweep_runs, "seed": seed, "Q_thrust_N2_per_s": Q_THRUST,
-                "Q_thrust_base_N2_per_s": Q_THRUST_BASE, "epsilon_s_per_N": THRUST_EPSILON, "window_steps": THRUST_WINDOW,
+                "Q_thrust_base_N2_per_s": Q_THRUST_BASE, "epsilon_s_per_N": THRUST_EPSILON, "window_steps": THRUST_MEMORY_STEPS,
                 "P0_thrust_std_N": P0_THRUST_STD, "windows_s": [list(w) for w in WINDOWS]}
     return ChaserStudy(rows=rows, sweeps=sweeps, runs0=runs0, settings=settings)
 
@@ -262,10 +262,10 @@ _STYLE = {
 }
 
 
-def plot_chaser(study, *, axes=None, window_s=10.0):
+def plot_chaser(study, *, axes=None, moving_rms_s=10.0):
     """Fig 4 with the ideas added: per-axis position and velocity errors of run 0, every filter.
 
-    Each curve is the moving RMS of the error over ``window_s`` (log scale),
+    Each curve is the moving RMS of the error over the last ``moving_rms_s`` seconds (log scale),
     so that the unaware EKF's metres and the others' centimetres show
     together and the noisy curves do not hide each other.
 
@@ -280,7 +280,7 @@ def plot_chaser(study, *, axes=None, window_s=10.0):
     any_res = next(iter(study.runs0.values()))
     state = any_res.state
     dt = float(any_res.t[1] - any_res.t[0])
-    w = max(1, int(round(window_s / dt)))
+    w = max(1, int(round(moving_rms_s / dt)))
     kernel = np.ones(w) / w
     for name, res in study.runs0.items():
         err = res.error[0]
@@ -294,7 +294,7 @@ def plot_chaser(study, *, axes=None, window_s=10.0):
             ax = axes[row, col]
             ax.axvline(500.0, color="k", ls=":", lw=0.8, label="t = 500 s" if row == col == 0 else None)
             ax.set_xlabel("time t (s)")
-            ax.set_ylabel(f"{window_s:g}-s RMS of Δ{state.labels[i]} ({state.units[i]})")
+            ax.set_ylabel(f"{moving_rms_s:g}-s RMS of Δ{state.labels[i]} ({state.units[i]})")
             ax.grid(True, which="both", alpha=0.3)
     axes[0, 0].legend(loc="upper right", fontsize=7)
     fig.suptitle("Sun 2011's maneuver, control law unknown: paper 002's ideas on the chaser (run 0)")

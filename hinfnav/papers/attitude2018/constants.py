@@ -103,5 +103,5 @@ DEFAULT_HOLD_NATURAL_FREQ = 0.02
 DEFAULT_HOLD_DAMPING = 0.7
 #: Strong-tracking defaults: forgetting factor ρ, weakening factor β (Zhou, Xi & Zhang 1991 use ρ = 0.95).
 DEFAULT_ST = {"rho": 0.95, "beta": 1.0}
-#: AAEKF defaults: window m (steps), Q(t₀) (N·m)²/s, floor. ε is set by :func:`default_epsilon`.
-DEFAULT_AA = {"window": 60, "Q0": PAPER_Q_ASTEKF, "floor": 1.0}
+#: AAEKF defaults: memory m of the rate estimate (steps), Q(t₀) (N·m)²/s, floor. ε is set by :func:`default_epsilon`.
+DEFAULT_AA = {"memory_steps": 60, "Q0": PAPER_Q_ASTEKF, "floor": 1.0}

@@ -236,16 +236,16 @@ def fig_error_vs_rate(study, Q=PAPER_Q_BEST_AEKF, name="aekf"):
     return fig
 
 
-def fig_fading(study, window=300):
-    """The ASTEKF's fading factor λ (run 0; all λᵢ equal with aᵢ = 1) and its moving mean over ``window`` steps."""
+def fig_fading(study, mean_steps=300):
+    """The ASTEKF's fading factor λ (run 0; all λᵢ equal with aᵢ = 1) and its moving mean over ``mean_steps`` steps."""
     st = study.main["astekf"]
     lam = st.diagnostics["fading"][:, 0]
     fig, axes = new_figure(1, 1, figsize=(10, 3.6))
     ax = axes[0, 0]
     step = max(1, lam.size // MAX_POINTS)
     ax.semilogy(st.t[::step], lam[::step], lw=0.4, color="0.6", label="λ (run 0)")
-    mov = np.convolve(lam, np.ones(window) / window, mode="same")
-    ax.semilogy(st.t, mov, color="C3", lw=1.2, label=f"moving mean over {window} steps")
+    mov = np.convolve(lam, np.ones(mean_steps) / mean_steps, mode="same")
+    ax.semilogy(st.t, mov, color="C3", lw=1.2, label=f"moving mean over {mean_steps} steps")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("fading factor λ (–)")
     ax.grid(True, which="both", alpha=0.3)
@@ -255,7 +255,7 @@ def fig_fading(study, window=300):
 
 
 def fig_tuning(study):
-    """The ASTEKF over (ρ, β) and the AAEKF over ε and the window m: RMS Euler and torque errors."""
+    """The ASTEKF over (ρ, β) and the AAEKF over ε and the rate memory m (steps): RMS Euler and torque errors."""
     fig, axes = new_figure(1, 2, figsize=(12, 4.2))
     ax = axes[0, 0]
     labels = [s.label for s in study.st_grid]
@@ -275,7 +275,7 @@ def fig_tuning(study):
         ax.plot([1.0], [s.euler_deg], "x", ms=8, label=f"Euler, {s.label}")
     ax.set_xlabel("ε / default ε (–)")
     ax.set_ylabel("RMS error (deg, 1e-2 N m)")
-    ax.set_title("AAEKF over its compression factor ε (m = 60) and window m", fontsize=9)
+    ax.set_title("AAEKF over its compression factor ε (m = 60) and rate memory m (steps)", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(True, which="both", alpha=0.3)
     fig.suptitle("What the two ideas' own parameters do (claims 3 and 5)")

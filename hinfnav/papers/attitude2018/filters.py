@@ -72,13 +72,13 @@ def build_astekf(scenario, Q=PAPER_Q_ASTEKF, *, rho=DEFAULT_ST["rho"], beta=DEFA
                           beta=beta, a=a, name=name, **options)
 
 
-def build_aaekf(scenario, Q0=DEFAULT_AA["Q0"], *, epsilon=None, window=DEFAULT_AA["window"], floor=DEFAULT_AA["floor"],
-                name="aaekf", **options):
-    """The AAEKF on ``scenario``: Q(t₀) = Q0 I₃, ε (default :func:`default_epsilon`; may be one per run), m = window."""
+def build_aaekf(scenario, Q0=DEFAULT_AA["Q0"], *, epsilon=None, memory_steps=DEFAULT_AA["memory_steps"],
+                floor=DEFAULT_AA["floor"], name="aaekf", **options):
+    """The AAEKF on ``scenario``: Q(t₀) = Q0 I₃, ε (default :func:`default_epsilon`; may be one per run), m = memory_steps."""
     _check(scenario)
     epsilon = default_epsilon(Q0=float(np.max(Q0)), omega_e=scenario.omega_e) if epsilon is None else epsilon
     return AttitudeAAEKF(scenario.system(), scenario.measurement, P0=scenario.P0, Q=torque_density(Q0),
-                         epsilon=epsilon, window=window, floor=floor, name=name, **options)
+                         epsilon=epsilon, memory_steps=memory_steps, floor=floor, name=name, **options)
 
 
 _BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}

@@ -1,17 +1,12 @@
 """``python -m hinfnav reproduce --paper attitude2018``: paper 002's Figs 1–9, its claims measured, the chaser study."""
 
-import json
-import time
-from pathlib import Path
-
 import numpy as np
-from tqdm import tqdm
 
 from ...io.outputs import to_json
 from ...core.validation import as_int_at_least
-from ..notebooks import run_notebooks
-from .chaser import chaser_study, format_chaser_table, plot_chaser
 from ..claims_table import write_claims_table
+from ..skeleton import Reproduction
+from .chaser import chaser_study, format_chaser_table, plot_chaser
 from .claims import format_claims, measure_claims
 from .constants import CITATION, PAPER_OMEGA_E_DEG_S, orbit_rate
 from .figures import (
@@ -30,10 +25,15 @@ from .figures import (
 from .scenario import Scenario
 from .studies import attitude_study
 
-__all__ = ["NOTEBOOKS", "reproduce", "stats_entry", "summarize", "to_json"]
+__all__ = ["NOTEBOOKS", "reproduce", "stats_entry", "summarize"]
 
-#: The notebooks of paper 002's decade.
-NOTEBOOKS = "2[0-9]_*.ipynb"
+#: This paper's chapter of the workbook (``reproduce(notebooks=True)``).
+NOTEBOOKS = (
+    "20_attitude_model.ipynb",
+    "21_aekf_q_tradeoff.ipynb",
+    "22_astekf_aaekf_claims.ipynb",
+    "23_chaser_ideas.ipynb",
+)
 
 
 def stats_entry(s):
@@ -86,15 +86,6 @@ def summarize(study, claims, chaser=None):
     return to_json(out)
 
 
-def _save(fig, out_dir, name):
-    for ext in ("png", "pdf"):
-        fig.savefig(Path(out_dir) / f"{name}.{ext}", dpi=110)
-
-
-def _execute_notebooks(out_dir):
-    return run_notebooks(out_dir, NOTEBOOKS)
-
-
 def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=False, progress=True, scenario=None,
               chaser=True):
     """Regenerate paper 002's Figs 1–9, the sweeps, the claims and the chaser study into ``out_dir``.
@@ -112,7 +103,7 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
         the chaser comparison; the sweeps use the first min(runs, 4) (attitude)
         and min(runs, 5) (chaser) runs of the same truths.
     notebooks : bool
-        Also execute notebooks ``2x_*.ipynb`` into ``out_dir``.
+        Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
     scenario : Scenario, optional
     chaser : bool
@@ -125,9 +116,8 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
     """
     scenario = Scenario() if scenario is None else scenario
     runs = as_int_at_least("runs", runs, 1)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
+    rep = Reproduction(out_dir, "attitude2018", notebooks=NOTEBOOKS if notebooks else (),
+                       progress=progress, dpi=110, seed=seed, runs=runs)
     study = attitude_study(scenario, runs=runs, seed=seed, progress=progress)
     claims = measure_claims(study)
     ch = chaser_study(runs=runs, seed=seed) if chaser else None
@@ -137,13 +127,11 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
             "fig10_q_sweep": lambda: fig_q_sweep(study), "fig11_tuning": lambda: fig_tuning(study)}
     if ch is not None:
         figs["fig12_chaser"] = lambda: plot_chaser(ch)
-    for name, make in tqdm(figs.items(), disable=not progress, desc="figures", unit="fig"):
-        _save(make(), out, name)
-    summary = summarize(study, claims, ch)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    write_claims_table(claims, out, "Paper 002 (gyroless attitude, 2018): the claims, their statistics and verdicts")
+    rep.save_figures(figs)
+    summary = rep.write_summary(summarize(study, claims, ch))
+    write_claims_table(claims, rep.out, "Paper 002 (gyroless attitude, 2018): the claims, their statistics and verdicts")
     if notebooks:
-        _execute_notebooks(out)
+        rep.run_notebooks()
     if progress:
         print(f"\norbit rate {summary['orbit_rate_deg_s']:.14f} deg/s (paper {PAPER_OMEGA_E_DEG_S}), "
               f"relative difference {summary['orbit_rate_check']['relative_difference']:.1e}")
@@ -151,5 +139,5 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
         if ch is not None:
             print("\nSun 2011's chaser, control law unknown (mean of per-run RMS over axes, 95 % interval):")
             print(format_chaser_table(ch))
-        print(f"\npaper 002 (attitude): done in {time.perf_counter() - t0:.0f} s")
+        print(f"\npaper 002 (attitude): done in {rep.elapsed_s:.0f} s")
     return summary

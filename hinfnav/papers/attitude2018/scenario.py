@@ -8,13 +8,13 @@ law on the true state whose torque the filters are told (the paper's known
 control torque T_c; no wheels, h = 0); the filters never see T_d.
 """
 
-import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ...core.exceptions import InputError
 from ...core.validation import as_matrix, as_positive, as_vector
+from ...sim.scenario import Scenario as BaseScenario
 from ...sim.truth import TruthModel
 from ...systems.attitude import (
     QUAT,
@@ -80,7 +80,7 @@ def default_epsilon(Q0=PAPER_Q_ASTEKF, Q_target=PAPER_Q_BEST_AEKF, T0=T0_NM, ome
 
 
 @dataclass(frozen=True, eq=False)
-class Scenario:
+class Scenario(BaseScenario):
     """Paper 002's scenario; defaults are the paper's numbers and the documented choices.
 
     Attributes
@@ -139,10 +139,6 @@ class Scenario:
         if self.duration_s < 10 * self.dt:
             raise InputError(f"orbits must give at least 10 samples; got {self.duration_s} s at dt = {self.dt} s")
 
-    def replace(self, **changes):
-        """A copy with some settings changed (validated again)."""
-        return dataclasses.replace(self, **changes)
-
     # -- orbit and torque --------------------------------------------------------------
 
     @property
@@ -176,16 +172,6 @@ class Scenario:
     def duration_s(self):
         """Simulated time, ``orbits`` orbital periods rounded up to a sample, s."""
         return float(np.ceil(self.orbits * self.orbital_period / self.dt) * self.dt)
-
-    @property
-    def n_steps(self):
-        """Number of sampling intervals."""
-        return int(round(self.duration_s / self.dt))
-
-    @property
-    def time(self):
-        """Sample times, s."""
-        return np.arange(self.n_steps + 1) * self.dt
 
     @property
     def rms_window_s(self):

@@ -326,7 +326,7 @@ def attitude_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, Qs=Q_SWEE
     eps_sweep = run_batched(build_aaekf, "epsilon", eps, small, scenario,
                             labels=[f"ε={f:g}×default" for f in EPSILON_FACTORS])
     bar.update(1)
-    win_sweep = [run_filter(f"m={m}", build_aaekf(scenario, epsilon=eps0, window=m), small, scenario, params={"window": m})
+    win_sweep = [run_filter(f"m={m}", build_aaekf(scenario, epsilon=eps0, memory_steps=m), small, scenario, params={"window": m})
                  for m in WINDOW_VALUES]
     bar.update(1)
     bar.close()
@@ -360,5 +360,5 @@ def est_params(key, eps0):
     return {
         "aekf": {"Q": PAPER_Q_BEST_AEKF},
         "astekf": {"Q": PAPER_Q_ASTEKF, **DEFAULT_ST},
-        "aaekf": {"Q0": DEFAULT_AA["Q0"], "epsilon": eps0, "window": DEFAULT_AA["window"], "floor": DEFAULT_AA["floor"]},
+        "aaekf": {"Q0": DEFAULT_AA["Q0"], "epsilon": eps0, "window": DEFAULT_AA["memory_steps"], "floor": DEFAULT_AA["floor"]},
     }[key]

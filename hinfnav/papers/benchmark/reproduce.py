@@ -1,29 +1,21 @@
 """``python -m hinfnav reproduce --paper benchmark``: the cross-paper table on Sun 2011's chaser, as a Dask campaign."""
 
-import time
 from pathlib import Path
-
-from tqdm import tqdm
 
 from ...campaign.runner import run_campaign
 from ...core.exceptions import InputError
-from ...io.outputs import write_json
-from ...io.provenance import provenance
 from ...core.validation import as_int_at_least
-from ...plotting.save import save_figure
-from ..notebooks import run_notebooks
+from ..skeleton import Reproduction, atomic_write_text
 from .grid import DELTAS, NOISES, TOL, WINDOWS, benchmark_campaign, fit_matrix, load_papers
 from .table import benchmark_table, best_by_condition, format_markdown, plot_heatmap
 
-__all__ = ["reproduce"]
+__all__ = ["NOTEBOOKS", "reproduce"]
+
+#: The comparison chapter of the workbook (``reproduce(notebooks=True)``).
+NOTEBOOKS = ("90_cross_paper_benchmark.ipynb",)
 
 #: Fewer runs than this is a quick look, not the benchmark (said in the summary).
 BENCHMARK_RUNS = 200
-
-
-def _execute_notebooks(out_dir, timeout=900):
-    """Execute the comparison decade's notebooks (``notebooks/9N_*.ipynb``) into ``out_dir``."""
-    return run_notebooks(out_dir, "9[0-9]_*.ipynb", timeout=timeout)
 
 
 def _note(runs):
@@ -44,7 +36,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     runs : int
         Monte Carlo runs per cell (the benchmark: ≥ 200).
     notebooks : bool
-        Also execute the notebooks into ``out_dir``.
+        Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
     client : None, "serial", str or distributed.Client
         Where the campaign runs (:func:`hinfnav.run_campaign`); default a LocalCluster on this machine's cores.
@@ -61,24 +53,23 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
         ``papers`` (which imported), ``elapsed_s`` and ``provenance``.
     """
     runs = as_int_at_least("runs", runs, 1)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
+    rep = Reproduction(out_dir, "benchmark", notebooks=NOTEBOOKS if notebooks else (),
+                       progress=progress, seed=seed, runs=runs)
+    out = rep.out
     papers = load_papers()
     for key, err in papers.items():
-        if err is not None and progress:
-            tqdm.write(f"paper {key} could not be imported, its estimators are left out: {err}")
+        if err is not None:
+            rep.say(f"paper {key} could not be imported, its estimators are left out: {err}")
     campaign = benchmark_campaign(runs=runs, seed=seed, estimators=estimators)
     cdir = Path(campaign_dir) if campaign_dir is not None else out / "campaign"
     results = run_campaign(campaign, client=client, out_dir=cdir / campaign.name, progress=progress)
     errors = dict(results.attrs["errors"])
     table = benchmark_table(results)
     names = list(dict.fromkeys(table["estimator"]))
-    prov = provenance(seed=seed, runs=runs, paper="benchmark")
     note = _note(runs)
     table.to_csv(out / "table.csv", index=False)
-    (out / "table.md").write_text(format_markdown(table, note=note))
-    save_figure(plot_heatmap(table), out, "heatmap", prov)
+    atomic_write_text(out / "table.md", format_markdown(table, note=note))
+    rep.save_figure(plot_heatmap(table), "heatmap")
     cells = [{**c["params"], "cell_id": c["cell_id"], "seed": c["seed"], "runs": c["runs"], "status": c["status"],
               "statistics": c["statistics"], "timing": c["timing"]} for c in results.attrs["cells"]]
     ratios = table.to_dict(orient="records")
@@ -86,7 +77,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
               for m, d, p, v, pp, vp in table[["maneuver", "delta", "kalman_pos_m", "kalman_vel_mps",
                                                "kalman_pos_m_predicted", "kalman_vel_mps_predicted"]]
               .drop_duplicates(["maneuver", "delta"]).itertuples(index=False)}
-    elapsed = time.perf_counter() - t0
+    elapsed = rep.elapsed_s
     summary = {
         "title": "Cross-paper benchmark on Sun et al. (2011)'s chaser (issue 13)",
         "note": note,
@@ -103,13 +94,12 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
         "cpu_s": sum(c["timing"]["estimator_cpu_s"] + c["timing"]["truth_cpu_s"] / c["timing"]["unit_cells"]
                      for c in cells),
         "elapsed_s": elapsed,
-        "provenance": prov,
     }
-    summary = write_json(out / "summary.json", summary)
+    summary = rep.write_summary(summary)
     if errors:
         raise InputError(f"{len(errors)} benchmark cells failed: " + "; ".join(f"{k}: {v}" for k, v in errors.items()))
     if notebooks:
-        _execute_notebooks(out)
+        rep.run_notebooks()
     if progress:
         print(f"\nbenchmark: {len(cells)} cells, {len(names)} estimators, {elapsed:.0f} s; table in {out / 'table.md'}")
     return summary

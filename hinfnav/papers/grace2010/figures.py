@@ -55,8 +55,8 @@ def mismatch_figure(prop):
     return fig
 
 
-def errors_figure(t, errors, variant, names=None, window=60):
-    """RMS position error per Hill axis over sliding ``window``-epoch windows (10 min), log scale, against
+def errors_figure(t, errors, variant, names=None, rms_epochs=60):
+    """RMS position error per Hill axis, a moving RMS over ``rms_epochs`` epochs (10 min), log scale, against
     time, with the truth's own ≈ 2.8 cm (1σ, relative) marked. ``errors``: filter name → (n, 6) error (m, m/s)."""
     names = list(errors) if names is None else names
     fig, ax = new_figure(3, 1, figsize=(10, 8), sharex=True)
@@ -64,7 +64,7 @@ def errors_figure(t, errors, variant, names=None, window=60):
     for i, lab in enumerate(("x (radial)", "y (along-track)", "z (normal)")):
         a = ax[i, 0]
         for name in names:
-            a.semilogy(t_h, np.sqrt(uniform_filter1d(errors[name][:, i] ** 2, window)), lw=0.8, label=name)
+            a.semilogy(t_h, np.sqrt(uniform_filter1d(errors[name][:, i] ** 2, rms_epochs)), lw=0.8, label=name)
         a.axhline(RELATIVE_TRUTH_SIGMA_M, color="k", ls="--", lw=1.0, label="truth's own 1σ (≈ 2.8 cm)")
         a.set_ylabel(f"RMS error {lab} (m)")
     ax[0, 0].legend(loc="upper right", fontsize=7, ncol=3)

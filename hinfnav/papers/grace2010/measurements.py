@@ -78,10 +78,10 @@ class MeasurementSet:
     notes: str
 
 
-def kband_noise(data, window=11, order=3):
+def kband_noise(data, savgol_length=11, order=3):
     """The K-band range's noise from the data (two independent estimates).
 
-    1. Residual of a smooth fit: a Savitzky–Golay filter (``window`` epochs, polynomial ``order``) through
+    1. Residual of a smooth fit: a Savitzky–Golay filter (``savgol_length`` epochs, polynomial ``order``) through
        the K-band series; the RMS residual, scaled by √(1/(1 − h₀)) for the fit's own leverage
        h₀ (the centre weight of the filter), is the white-noise σ at 10 s.
     2. Against the POD baseline: mean (a bias), standard deviation and max of ``K-band − |r_A − r_B|``.
@@ -91,11 +91,11 @@ def kband_noise(data, window=11, order=3):
     dict (m)
     """
     k = data.kband
-    res = k - savgol_filter(k, window, order)
-    h0 = savgol_coeffs(window, order)[window // 2]
-    inner = res[window:-window]
+    res = k - savgol_filter(k, savgol_length, order)
+    h0 = savgol_coeffs(savgol_length, order)[savgol_length // 2]
+    inner = res[savgol_length:-savgol_length]
     d = k - data.baseline[: k.size]
-    return {"savgol_window": window, "savgol_order": order,
+    return {"savgol_window": savgol_length, "savgol_order": order,
             "sigma_smooth_fit_m": float(np.sqrt(np.mean(inner**2) / (1 - h0))),
             "kband_minus_pod_mean_m": float(d.mean()), "kband_minus_pod_std_m": float(d.std()),
             "kband_minus_pod_rms_m": float(np.sqrt(np.mean(d**2))), "kband_minus_pod_maxabs_m": float(np.abs(d).max())}

@@ -6,17 +6,13 @@ every measurement variant, with provenance), ``results.csv`` and ``results.md`` 
 figures ``truth``, ``mismatch`` and ``errors_<variant>`` (PNG and PDF).
 """
 
-import os
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ...io.outputs import to_json, write_json
-from ...io.provenance import provenance
 from ...core.validation import as_int_at_least, as_seed
-from ...plotting.save import save_figure
-from ..notebooks import run_notebooks
+from ..skeleton import Reproduction, atomic_write_text
 from .constants import CITATION, DT_S, KBAND_TOLERANCE_M, TRUTH_SIGMA_M
 from .dataset import load
 from .figures import errors_figure, mismatch_figure, truth_figure
@@ -32,17 +28,14 @@ from .measurements import VARIANTS, kband_noise, linear_form, make_measurements
 from .mismatch import chief_rate_range, one_step_mismatch, propagation_errors
 from .studies import SETTLE_S, error_metrics, run_filter
 
-__all__ = ["reproduce", "kband_check", "run_study", "DESIGN_DELTA_BAR", "table_rows", "write_table",
-           "execute_notebooks"]
+__all__ = ["NOTEBOOKS", "reproduce", "kband_check", "run_study", "DESIGN_DELTA_BAR", "table_rows", "write_table"]
+
+#: This study's chapter of the workbook (``reproduce(notebooks=True)``).
+NOTEBOOKS = ("40_grace_real_formation.ipynb",)
 
 #: δ̄ of the LMI designs actually run: the data's covering δ̄ makes LMI (20) infeasible (checked in every
 #: run and reported); in trials 0.02 was infeasible too and 0.005 feasible, so 0.005 is used (a choice, not a fit).
 DESIGN_DELTA_BAR = 0.005
-
-
-def execute_notebooks(out_dir, timeout=900):
-    """Execute this study's notebooks (``notebooks/4N_*.ipynb``) into ``out_dir``."""
-    return run_notebooks(out_dir, "4[0-9]_*.ipynb", timeout=timeout)
 
 
 def kband_check(data, tolerance_m=KBAND_TOLERANCE_M):
@@ -127,18 +120,12 @@ def table_rows(table):
     return rows
 
 
-def _atomic_text(path, text):
-    tmp = Path(str(path) + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
 def write_table(rows, out):
     """``results.csv`` and ``results.md`` from :func:`table_rows`, each written atomically."""
     keys = list(rows[0])
     csv = ",".join(keys) + "\n" + "".join(",".join(str(r[k]) if isinstance(r[k], str) else f"{r[k]:.6g}"
                                                     for k in keys) + "\n" for r in rows)
-    _atomic_text(Path(out) / "results.csv", csv)
+    atomic_write_text(Path(out) / "results.csv", csv)
     head = "| variant | filter | RMS x (m) | RMS y (m) | RMS z (m) | RMS pos (m) | RMS vel (m/s) | NEES (6 ideal) | certified γ |\n"
     md = head + "|---|---|---|---|---|---|---|---|---|\n"
     for r in rows:
@@ -147,7 +134,7 @@ def write_table(rows, out):
         ne = "–" if np.isnan(r["nees"]) else f"{r['nees']:.3g}"
         md += (f"| {r['variant']} | {r['filter']} | {r['rms_x_m']:.3g} | {r['rms_y_m']:.3g} | {r['rms_z_m']:.3g} | "
                f"{r['rms_position_m']:.3g} | {vel:.3g} | {ne} | {g} |\n")
-    _atomic_text(Path(out) / "results.md", md)
+    atomic_write_text(Path(out) / "results.md", md)
     return md
 
 
@@ -163,6 +150,7 @@ def reproduce(out_dir="results/grace2010", *, seed=0, runs=1, notebooks=False, p
         Accepted for ``reproduce --paper all``; the study is one real day, so the data are one run (the
         value is recorded in the settings, never used).
     notebooks : bool
+        Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
     formats : tuple of str
 
@@ -172,11 +160,9 @@ def reproduce(out_dir="results/grace2010", *, seed=0, runs=1, notebooks=False, p
         The summary written.
     """
     runs = as_int_at_least("runs", 1 if runs is None else runs, 1)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    t_start = time.perf_counter()
-    say = print if progress else (lambda *a: None)
-    prov = provenance(seed=seed, paper="grace2010")
+    rep = Reproduction(out_dir, "grace2010", notebooks=NOTEBOOKS if notebooks else (),
+                       progress=progress, formats=formats, seed=seed)
+    out, say = rep.out, rep.say
     data = load()
     check = kband_check(data)
     say("grace2010: propagation mismatch ...")
@@ -187,11 +173,9 @@ def reproduce(out_dir="results/grace2010", *, seed=0, runs=1, notebooks=False, p
     study = run_study(data, seed=seed, keep_errors=True)
     rows = table_rows(study["table"])
     md = write_table(rows, out)
-    save_figure(truth_figure(data, check), out, "truth", prov, formats=formats)
-    save_figure(mismatch_figure(prop), out, "mismatch", prov, formats=formats)
-    for variant in ("gnss", "kband_angles"):
-        save_figure(errors_figure(study["t"], study["errors"][variant], variant), out, f"errors_{variant}", prov,
-                    formats=formats)
+    rep.save_figures({"truth": lambda: truth_figure(data, check), "mismatch": lambda: mismatch_figure(prop),
+                      **{f"errors_{v}": (lambda v=v: errors_figure(study["t"], study["errors"][v], v))
+                         for v in ("gnss", "kband_angles")}})
     one = study["one_step"]
     summary = {
         "paper": CITATION,
@@ -216,11 +200,10 @@ def reproduce(out_dir="results/grace2010", *, seed=0, runs=1, notebooks=False, p
         "table": study["table"],
         "table_markdown": md,
     }
-    timings = dict(study["timings"], propagation_s=t_prop, total_s=time.perf_counter() - t_start)
+    timings = dict(study["timings"], propagation_s=t_prop, total_s=rep.elapsed_s)
     summary["timing_s"] = timings
-    summary["provenance"] = prov
-    summary = write_json(out / "summary.json", to_json(summary, strict=True))
+    summary = rep.write_summary(summary, strict=True)
     if notebooks:
-        execute_notebooks(out)
+        rep.run_notebooks()
     say(f"grace2010: done in {timings['total_s']:.0f} s\n{md}")
     return summary

@@ -73,7 +73,7 @@ def riccati_accuracy(scenario, *, maneuver=False, window=None):
     maneuver : bool
         Take R_k along the trajectory with the maneuver (a filter that knew it).
     window : (float, float), optional
-        Default ``scenario.window_s``.
+        Default ``scenario.rms_window_s``.
 
     Returns
     -------
@@ -81,7 +81,7 @@ def riccati_accuracy(scenario, *, maneuver=False, window=None):
     """
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario must be a hinfnav Shi 2018 Scenario; got {type(scenario).__name__}")
-    window = scenario.window_s if window is None else window
+    window = scenario.rms_window_s if window is None else window
     mask = window_mask(scenario.time, window)
     system = scenario.system()
     Phi, Q = system.Phi, system.Q

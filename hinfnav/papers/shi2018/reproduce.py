@@ -10,19 +10,17 @@ calibrated choice and how it was made), ``kalman_limit`` and ``verdicts``.
 """
 
 import concurrent.futures
-import json
 import multiprocessing
 import os
-import time
-from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from ...core.exceptions import InputError
+from ...io.outputs import to_json
 from ...io.progress import bar_disabled
 from ...core.validation import as_int_at_least
-from ..notebooks import run_notebooks
+from ..skeleton import Reproduction
 from .calibration import riccati_accuracy
 from .constants import (
     CALIBRATION_TARGET,
@@ -41,7 +39,14 @@ from .studies import filter_summary, maneuver_reaction, maneuver_windows, paired
 from .sweeps import MISTUNING_FACTORS, SENSOR_VARIANTS, mistuning_point, sensitivity_point
 from .table import format_table, write_table
 
-__all__ = ["STATISTIC", "statistic", "reproduce", "study", "verdicts", "to_json", "execute_notebooks"]
+__all__ = ["NOTEBOOKS", "STATISTIC", "statistic", "reproduce", "study", "verdicts"]
+
+#: This paper's chapter of the workbook (``reproduce(notebooks=True)``).
+NOTEBOOKS = (
+    "10_shi2018_model_and_measurement.ipynb",
+    "11_shi2018_huber_m_estimation.ipynb",
+    "12_shi2018_reproduction.ipynb",
+)
 
 #: What "accuracy" means in this reproduction (the window is the scenario's, 200-1000 s by default).
 STATISTIC = ("RMS of the estimation error over t = {start:g}-{end:g} s, taken over the three axes, "
@@ -50,22 +55,7 @@ STATISTIC = ("RMS of the estimation error over t = {start:g}-{end:g} s, taken ov
 
 def statistic(scenario):
     """:data:`STATISTIC` with the scenario's window."""
-    return STATISTIC.format(start=scenario.window_s[0], end=scenario.window_s[1])
-
-
-def to_json(obj):
-    """Plain Python types for ``json.dumps`` (arrays to lists, numpy scalars to numbers, NaN to None)."""
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {str(k): to_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_json(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_json(obj.tolist())
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return to_json(obj.item())
-    return obj
+    return STATISTIC.format(start=scenario.rms_window_s[0], end=scenario.rms_window_s[1])
 
 
 def _pair(res, a="hbf", b="ekf"):
@@ -242,7 +232,7 @@ def study(scenario=None, *, runs=100, seed=0, sweep_runs=None, progress=False, w
         "paper": {"citation": CITATION, "results": PAPER_RESULTS, "claims": PAPER_CLAIMS},
         "statistic": statistic(sc),
         "settings": {"runs": runs, "sweep_runs": sweep_runs, "seed": seed, "dt_s": sc.dt, "duration_s": sc.duration_s,
-                     "window_s": list(sc.window_s), "orbital_rate_radps": sc.n, "gamma": GAMMA,
+                     "window_s": list(sc.rms_window_s), "orbital_rate_radps": sc.n, "gamma": GAMMA,
                      "x0": sc.x0, "xhat0": sc.xhat0, "P0_std": np.sqrt(np.diag(sc.P0)),
                      "default_P0_std": P0_STD, "maneuver_time_s": sc.maneuver_time_s},
         "sensor_errors": {**sc.sensor_errors(), "calibrated_to": CALIBRATION_TARGET,
@@ -260,7 +250,7 @@ def study(scenario=None, *, runs=100, seed=0, sweep_runs=None, progress=False, w
     results = {"gaussian": gaussian, "mixture": mixture, "mixture_variance_reading": mixture_var,
                "maneuver": maneuver, "maneuver_quiet": maneuver_quiet, "sensitivity": sensitivity,
                "mistuning": mistuning, "kalman_limit": lim}
-    return to_json(summary), results
+    return to_json(summary, strict=True), results
 
 
 #: Sensor-error factor of the maneuver case run again with quieter sensors.
@@ -289,16 +279,6 @@ def _pair_window(res, label):
     return out
 
 
-def _save(fig, out_dir, name):
-    for ext in ("png", "pdf"):
-        fig.savefig(Path(out_dir) / f"{name}.{ext}", dpi=130)
-
-
-def execute_notebooks(out_dir, timeout=900):
-    """Execute this paper's notebooks (``notebooks/1[0-9]_*.ipynb``) into ``out_dir``."""
-    return run_notebooks(out_dir, "1[0-9]_*.ipynb", timeout=timeout)
-
-
 def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, progress=True, scenario=None,
               workers=None):
     """Regenerate the figures, the results table and ``summary.json`` into ``out_dir``.
@@ -310,7 +290,7 @@ def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, p
     runs : int
         Monte Carlo runs of each case (≥ 2; the sweeps use a quarter as many).
     notebooks : bool
-        Also execute notebooks 10–19 into ``out_dir``.
+        Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
         Progress bars and the printed table.
     scenario : Scenario, optional
@@ -323,9 +303,8 @@ def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, p
     dict
         The summary written to ``summary.json``.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
+    rep = Reproduction(out_dir, "shi2018", notebooks=NOTEBOOKS if notebooks else (),
+                       progress=progress, seed=seed, runs=runs)
     workers = min(2, os.cpu_count() or 1) if workers is None else workers
     summary, res = study(scenario, runs=runs, seed=seed, progress=progress, workers=workers)
     sc = Scenario() if scenario is None else scenario
@@ -335,18 +314,17 @@ def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, p
             "maneuver_reaction": maneuver_figure(res["maneuver"], sc),
             "sweeps": sweeps_figure(res["sensitivity"], res["mistuning"])}
     figs["mixture_position"], figs["mixture_velocity"] = mixture_figures(res["mixture"], summary)
-    for name, fig in tqdm(figs.items(), disable=bar_disabled(progress), desc="figures", unit="fig"):
-        _save(fig, out, name)
-    write_table(summary, out)
-    summary["elapsed_s"] = time.perf_counter() - t0
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    rep.save_figures(figs)
+    write_table(summary, rep.out)
+    summary["elapsed_s"] = rep.elapsed_s
+    summary = rep.write_summary(summary, strict=True)
     if notebooks:
-        execute_notebooks(out)
+        rep.run_notebooks()
     if progress:
         print()
         print("Shi & Wang (2018), paper vs reproduced (" + summary["statistic"] + ")")
         print(format_table(summary))
         for case, v in summary["verdicts"].items():
             print(f"{case}: {'reproduced' if v['reproduced'] else 'NOT reproduced'} — {v['text']}")
-        print(f"\nShi & Wang 2018: done in {time.perf_counter() - t0:.0f} s")
+        print(f"\nShi & Wang 2018: done in {rep.elapsed_s:.0f} s")
     return summary

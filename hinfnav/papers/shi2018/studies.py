@@ -60,7 +60,7 @@ MANEUVER_WINDOWS = ("before", "reaction", "final")
 def maneuver_windows(scenario):
     """The maneuver case's extra windows, s: ``{"before": …, "reaction": …, "final": …}`` (500 s, 1000 s run:
     200–500, 500–700, 800–1000)."""
-    start, end = scenario.window_s
+    start, end = scenario.rms_window_s
     tm = scenario.maneuver_time_s
     return {"before": (start, tm), "reaction": (tm, min(tm + 200.0, end)), "final": (max(end - 200.0, tm), end)}
 
@@ -172,7 +172,7 @@ def run_case(scenario, case, filters=None, *, runs=100, seed=0, batch_size=100, 
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
     t = scenario.time
-    mask = window_mask(t, scenario.window_s)
+    mask = window_mask(t, scenario.rms_window_s)
     win_masks = {}
     if case == "maneuver":
         win_masks = {k: window_mask(t, w) for k, w in maneuver_windows(scenario).items() if w[0] < w[1]}
@@ -222,7 +222,7 @@ def run_case(scenario, case, filters=None, *, runs=100, seed=0, batch_size=100, 
                 "measurement_noise": noise if isinstance(noise, str) else
                 {"name": noise.name, "eps": noise.eps, "ratio": noise.ratio, "variance": noise.variance},
                 "process_noise": "gaussian", "runs": runs, "seed": seed}
-    return CaseResult(case=case, t=t, runs=runs, seed=seed, window_s=scenario.window_s, filters=stats,
+    return CaseResult(case=case, t=t, runs=runs, seed=seed, window_s=scenario.rms_window_s, filters=stats,
                       settings=settings)
 
 

@@ -1,26 +1,32 @@
 """``python -m hinfnav reproduce --paper sun2011``: Table 1 and Figs 2–7 of Sun et al. (2011) into a folder."""
 
-import time
-from pathlib import Path
-
-from tqdm import tqdm
-
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_seed
-from ...io.outputs import to_json, write_json
-from ...io.progress import bar_disabled
-from ...io.provenance import provenance
 from ...metrics.errors import rms_per_run
-from ...plotting.save import save_figure
-from ..notebooks import run_notebooks
+from ..notebooks import CROSS_PAPER
+from ..skeleton import Reproduction
 from .constants import CITATION
 from .designs import design_for_scenario
 from .figures import fig2, fig3, fig4, fig5, fig6, fig7, fig7_result, paper_runs
 from .scenario import Scenario
 from .table1 import CASES, _kl_axes, format_table1, table1, write_table1
 
-__all__ = ["reproduce", "execute_notebooks", "to_json"]
+__all__ = ["NOTEBOOKS", "reproduce"]
 
+#: This paper's chapter of the workbook (``reproduce(notebooks=True)`` also runs
+#: :data:`hinfnav.papers.notebooks.CROSS_PAPER`: sun2011 writes into the output folder's root).
+NOTEBOOKS = (
+    "01_model_and_scenario.ipynb",
+    "02_derivation.ipynb",
+    "03_design_vs_delta.ipynb",
+    "04_table1.ipynb",
+    "05_figs_2_to_6.ipynb",
+    "06_fig7_uncertainty_and_non_gaussian.ipynb",
+    "07_closed_loop.ipynb",
+    "08_mixed_h2_hinf.ipynb",
+    "09_your_own_plant_polytopes.ipynb",
+    "91_interactive_design_and_errors.ipynb",
+)
 
 
 def _summary(tab, designed, observer, fig7_res, scenario):
@@ -57,18 +63,13 @@ def _summary(tab, designed, observer, fig7_res, scenario):
     }
 
 
-def execute_notebooks(out_dir, timeout=900):
-    """Execute every ``notebooks/NN_*.ipynb`` of the repository into ``out_dir``."""
-    return run_notebooks(out_dir, "[0-9][0-9]_*.ipynb", timeout=timeout)
-
-
 def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=True, scenario=None):
     """Regenerate Table 1 and Figs 2–7 into ``out_dir``.
 
     Writes ``fig2`` … ``fig7`` (PNG and PDF), ``fig4`` with both EKF variants,
     ``table1.csv``, ``table1.md`` and ``summary.json``, prints the
-    paper-vs-reproduced table, and with ``notebooks=True`` also executes the
-    notebooks into ``out_dir``.
+    paper-vs-reproduced table, and with ``notebooks=True`` also executes
+    :data:`NOTEBOOKS` and the cross-paper notebooks into ``out_dir``.
 
     Returns
     -------
@@ -80,11 +81,9 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
         raise InputError(f"scenario must be a hinfnav Sun 2011 Scenario; got {type(scenario).__name__}")
     runs = as_int_at_least("runs", runs, 1)
     as_seed("seed", seed)  # before the designs, not after them
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    prov = provenance(seed=seed, runs=runs, paper="sun2011")
-    t0 = time.perf_counter()
-    say = (lambda msg: tqdm.write(msg)) if progress else (lambda msg: None)
+    rep = Reproduction(out_dir, "sun2011", notebooks=NOTEBOOKS + CROSS_PAPER if notebooks else (),
+                       progress=progress, seed=seed, runs=runs)
+    out, prov, say = rep.out, rep.provenance, rep.say
     say("designing the robust H∞ filter at δ̄ = 0.05 (Corollary 1) ...")
     designed = design_for_scenario(scenario, delta_bar=0.05)
     say(f"  certified γ = {designed.gamma:.4g} (LMI: {designed.lmi_gamma:.4g})")
@@ -96,14 +95,13 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
     f7 = fig7_result(scenario, seed=seed)
     figs = {"fig2": fig2(runs_), "fig3": fig3(runs_), "fig4": fig4(runs_), "fig5": fig5(runs_), "fig6": fig6(runs_),
             "fig7": fig7(f7)}
-    for name, fig in tqdm(figs.items(), disable=bar_disabled(progress), desc="figures", unit="fig"):
-        save_figure(fig, out, name, prov)
-    summary = write_json(out / "summary.json", dict(_summary(tab, designed, observer, f7, scenario), provenance=prov))
+    rep.save_figures(figs)
+    summary = rep.write_summary(_summary(tab, designed, observer, f7, scenario))
     if notebooks:
-        execute_notebooks(out)
+        rep.run_notebooks()
     if progress:
         print()
         print("Table 1, paper vs reproduced: per-axis RMS over the window, RMS over x, y, z; 1 run and mean ± 95% CI")
         print(format_table1(tab))
-        print(f"\nSun 2011 reproduced in {time.perf_counter() - t0:.0f} s")
+        print(f"\nSun 2011 reproduced in {rep.elapsed_s:.0f} s")
     return summary

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -22,6 +22,7 @@ from ...core.linalg import discretize, spectral_radius
 from ...core.validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real, as_vector
 from ...design.result import SynthesisResult
 from ...estimators.lti import LTIFilter
+from ...sim.scenario import Scenario as BaseScenario
 from ...sim.truth import TruthModel
 from ...systems.hill import (
     delta_A1,
@@ -50,7 +51,7 @@ def _readonly(name, value, shape):
 
 
 @dataclass(frozen=True, eq=False)
-class Scenario:
+class Scenario(BaseScenario):
     """Settings of one relative-navigation scenario; defaults are the paper's.
 
     Attributes
@@ -113,31 +114,9 @@ class Scenario:
         set_("B", _readonly("B", self.B, (6, None)))
         set_("D", _readonly("D", self.D, (3, None)))
         set_("L", _readonly("L", self.L, (None, 6)))
-        try:
-            start, end = (float(t) for t in self.rms_window_s)
-        except (TypeError, ValueError):
-            raise InputError(f"rms_window_s must be a pair (start, end) in seconds; got {self.rms_window_s!r}") from None
-        if not (0 <= start < end <= self.duration_s):
-            raise InputError(
-                f"rms_window_s must satisfy 0 <= start < end <= duration_s = {self.duration_s}; got ({start}, {end})"
-            )
-        set_("rms_window_s", (start, end))
+        set_("rms_window_s", self.checked_window("rms_window_s"))
         if self.duration_s < self.dt:
             raise InputError(f"duration_s must be at least one sampling time dt = {self.dt}; got {self.duration_s}")
-
-    def replace(self, **changes: Any) -> Scenario:
-        """A copy with some settings changed (validated again)."""
-        return dataclasses.replace(self, **changes)
-
-    @property
-    def n_steps(self) -> int:
-        """Number of sampling intervals, ``round(duration_s / dt)``."""
-        return int(round(self.duration_s / self.dt))
-
-    @property
-    def time(self) -> NDArray[np.float64]:
-        """Sample times ``t_k = k T``, shape (n_steps + 1,), s."""
-        return np.arange(self.n_steps + 1) * self.dt
 
     def continuous_matrices(self, delta: float = 0.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(A₀(ω₀(1+δ)), G₀)`` of (2), shapes (6, 6) and (6, 3)."""

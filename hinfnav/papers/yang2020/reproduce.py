@@ -11,20 +11,13 @@ Runs, with the scenario's readings (``Scenario()``: 3×10⁵ steps):
 
 import time
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...io.outputs import to_json as _to_json
-from ...io.outputs import write_json
-from ...io.progress import bar_disabled
-from ...io.provenance import provenance
 from ...core.validation import as_int_at_least
-from ...plotting.save import save_figure
 from ..claims_table import write_claims_table
-from ..notebooks import run_notebooks
+from ..skeleton import Reproduction
 from .claims import evaluate_claims
 from .constants import CITATION, READING_REASONS, REQUIREMENT_ASD, TABLE2
 from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12
@@ -43,8 +36,15 @@ from .studies import (
     truncated,
 )
 
-__all__ = ["reproduce", "READING_RUNS", "reading_study", "integral_study", "algorithm_windows", "to_json",
-           "execute_notebooks"]
+__all__ = ["NOTEBOOKS", "reproduce", "READING_RUNS", "reading_study", "integral_study", "algorithm_windows"]
+
+#: This paper's chapter of the workbook (``reproduce(notebooks=True)``).
+NOTEBOOKS = (
+    "30_yang2020_model.ipynb",
+    "31_yang2020_algorithm2.ipynb",
+    "32_yang2020_closed_loop.ipynb",
+    "33_yang2020_claims.ipynb",
+)
 
 #: Largest runs × steps of one reproduction (the histories of a 3×10⁵-step run take ~0.2 GB).
 MAX_RUN_STEPS = 2_400_000
@@ -56,20 +56,6 @@ READING_RUNS = {
     "omega_d_rad_s": {"omega_d": "rad_s"},
     "timing_prior": {"timing": "prior"},
 }
-
-
-def to_json(obj):
-    """Plain Python (dicts, lists, floats) from numpy values, NaN and infinities as None (JSON has neither)."""
-    return _to_json(obj, strict=True)
-
-
-def execute_notebooks(out_dir, timeout=900):
-    """Execute this paper's notebooks (``notebooks/3N_*.ipynb``) into ``out_dir``."""
-    return run_notebooks(out_dir, "3[0-9]_*.ipynb", timeout=timeout)
-
-
-def _save(fig, out, name, formats, prov):
-    save_figure(fig, out, name, prov, formats=formats)
 
 
 def algorithm_windows(n_passive, dt, early_s=300.0, late_s=2000.0, skip_s=10.0):
@@ -124,7 +110,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         Monte Carlo runs of every loop (1 by default: the paper shows single runs); at most
         ``MAX_RUN_STEPS / n_steps`` (8 at full length), for memory.
     notebooks : bool
-        Also execute the notebooks into ``out_dir``.
+        Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
     scenario : Scenario, optional
         Default ``Scenario()`` (3×10⁵ steps, default readings).
@@ -144,11 +130,9 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         raise InputError(f"runs = {runs} of {sc.n_steps} steps would keep {runs * sc.n_steps:.3g} steps of history "
                          f"(about 0.6 kB a step); at most {MAX_RUN_STEPS:.3g}: use runs <= "
                          f"{max(1, MAX_RUN_STEPS // sc.n_steps)} (the paper shows single runs)")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    t_start = time.perf_counter()
-    prov = provenance(seed=seed, runs=runs, paper="yang2020", n_steps=sc.n_steps)
-    say = (lambda msg: tqdm.write(msg)) if progress else (lambda msg: None)
+    rep = Reproduction(out_dir, "yang2020", notebooks=NOTEBOOKS if notebooks else (),
+                       progress=progress, formats=formats, seed=seed, runs=runs, n_steps=sc.n_steps)
+    say = rep.say
     timings = {}
 
     say(f"yang2020: ADRC closed loop, {sc.n_steps} steps ...")
@@ -170,9 +154,8 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     for r in ("relative", "accelerometer"):
         by_reading[f"residual_{r}"] = reading_study(sc, {"residual": r}, n_steps=n_rec, seed=seed, result=main)
     steady_from = main.settings["fused_steady_from_step"]
-    for name, fig in (("fig6", fig6(main)), ("fig7", fig7(main)), ("fig8", fig8(main)), ("fig10", fig10(main)),
-                      ("fig11", fig11(main))):
-        _save(fig, out, name, formats, prov)
+    rep.save_figures({"fig6": fig6(main), "fig7": fig7(main), "fig8": fig8(main), "fig10": fig10(main),
+                      "fig11": fig11(main)})
     main_r = main
 
     say("yang2020: tuned PID and ADRC on the same PID ...")
@@ -185,9 +168,9 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         per[kind] = periodic_amplitude(res.x[:, k0:, 6], res.t[k0:], sc.w_d)
         spectra[f"{kind}_test_mass"] = residual_spectrum(res, sc.residual, sc.settle_s)
         loops9[label] = res
-    _save(fig9(loops9), out, "fig9", formats, prov)
-    _save(fig12({"PID": spectra["pid_test_mass"], "ADRC on the PID": spectra["adrc_pid_test_mass"],
-                 "ADRC (NLPID)": spectra[sc.residual]}), out, "fig12", formats, prov)
+    rep.save_figure(fig9(loops9), "fig9")
+    rep.save_figure(fig12({"PID": spectra["pid_test_mass"], "ADRC on the PID": spectra["adrc_pid_test_mass"],
+                           "ADRC (NLPID)": spectra[sc.residual]}), "fig12")
     del loops9, res, main
 
     say(f"yang2020: drag-free loop open (Fig 5), {open_loop_steps} steps ...")
@@ -197,13 +180,13 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     timings["open_loop_s"] = time.perf_counter() - t0
     est_open = estimation_errors(open_)
     theta_open = theta_readings_study(open_, sc)
-    _save(fig5(open_), out, "fig5", formats, prov)
+    rep.save_figure(fig5(open_), "fig5")
     sat_open = saturation_summary(open_)
     del open_
 
     say("yang2020: the 3e-14 claim under the other readings ...")
     t0 = time.perf_counter()
-    for name, changes in tqdm(READING_RUNS.items(), disable=bar_disabled(progress), desc="readings", leave=False):
+    for name, changes in rep.bar(READING_RUNS.items(), "readings", leave=False):
         by_reading[name] = reading_study(sc, changes, n_steps=n_rec, seed=seed, runs=runs)
     integral = {i: integral_study(sc, i, n_steps=min(integral_steps, sc.n_steps), seed=seed) for i in ("printed", "dt")}
     timings["reading_studies_s"] = time.perf_counter() - t0
@@ -247,13 +230,12 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         "integral_readings": integral,
     }
     summary["claims"] = evaluate_claims(summary)
-    timings["total_s"] = time.perf_counter() - t_start
+    timings["total_s"] = rep.elapsed_s
     summary["timing_s"] = timings
-    summary["provenance"] = prov
-    summary = write_json(out / "summary.json", to_json(summary))
-    write_claims_table(summary["claims"], out, "Yang et al. (2020): the claims, their statistics and verdicts")
+    summary = rep.write_summary(summary, strict=True)
+    write_claims_table(summary["claims"], rep.out, "Yang et al. (2020): the claims, their statistics and verdicts")
     if notebooks:
-        execute_notebooks(out)
+        rep.run_notebooks()
     if progress:
         print(f"\nYang et al. 2020: done in {timings['total_s']:.0f} s")
         for c in summary["claims"]:

@@ -18,6 +18,7 @@ from ...control.adrc import DragFreeADRC, NonlinearPID
 from ...control.feedback import LinearFeedback
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_int_at_least, as_positive, as_real
+from ...sim.scenario import Scenario as BaseScenario
 from ...sim.truth import TruthModel
 from ...systems.linear import LinearSystem
 from ...systems.measurements import LinearMeasurement, Saturated
@@ -78,7 +79,7 @@ def _model(k_rot_sign):
 
 
 @dataclass(frozen=True)
-class Scenario:
+class Scenario(BaseScenario):
     """Yang et al. (2020), Section 3, with its readings.
 
     Attributes

@@ -1,0 +1,135 @@
+"""The base of every scenario: a frozen dataclass of settings with ``replace``, ``n_steps``, ``time`` and one RMS window.
+
+A paper's scenario subclasses :class:`Scenario` as a frozen dataclass that
+defines (as fields or properties) the sampling time ``dt`` (s) and the run
+length ``duration_s`` (s); it inherits
+
+* :meth:`Scenario.replace` — a validated copy; an unknown field is an
+  :class:`~hinfnav.core.exceptions.InputError` naming it and the known ones;
+* :attr:`Scenario.n_steps` — the number of sampling intervals
+  ``N = round(duration_s / dt)``;
+* :attr:`Scenario.time` — the sample times ``t_k = k dt``, ``k = 0 … N`` (s);
+* :meth:`Scenario.checked_window` — the validation of the RMS window
+  ``rms_window_s = (start, end)`` (s), ``0 ≤ start < end ≤ duration_s``, the one
+  name every scenario gives the window of its RMS error statistic.
+
+A field renamed in a release keeps working for one release through
+:func:`renamed_fields` (the old keyword and attribute warn with a
+:class:`DeprecationWarning` and reach the new field).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import warnings
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core.exceptions import InputError
+
+__all__ = ["Scenario", "renamed_fields"]
+
+
+class Scenario:
+    """Base of the scenarios (subclasses are frozen dataclasses defining ``dt`` and ``duration_s``, s).
+
+    Attributes
+    ----------
+    RENAMED : dict of str to str
+        Deprecated keyword → current field (set through :func:`renamed_fields`).
+    """
+
+    RENAMED: ClassVar[dict[str, str]] = {}
+
+    dt: float
+    duration_s: float
+
+    def replace(self, **changes: Any) -> Scenario:
+        """A copy with some settings changed, validated again like a new scenario.
+
+        Raises
+        ------
+        InputError
+            A keyword that is not a field of this scenario (the message names it and lists the fields).
+        """
+        changes = _translate(type(self), changes)
+        fields = [f.name for f in dataclasses.fields(self) if f.init]
+        unknown = [k for k in changes if k not in fields]
+        if unknown:
+            raise InputError(f"{type(self).__name__}.replace: unknown field {unknown[0]!r}; the fields are "
+                             f"{', '.join(fields)}")
+        return dataclasses.replace(self, **changes)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of sampling intervals, ``round(duration_s / dt)``."""
+        return int(round(self.duration_s / self.dt))
+
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """Sample times ``t_k = k dt``, shape (n_steps + 1,), s."""
+        return np.arange(self.n_steps + 1) * self.dt
+
+    def checked_window(self, name: str = "rms_window_s") -> tuple[float, float]:
+        """The window field ``name`` as a pair of floats (start, end), s, checked against the run.
+
+        Raises
+        ------
+        InputError
+            Not a pair of numbers, or not ``0 <= start < end <= duration_s``.
+        """
+        value = getattr(self, name)
+        try:
+            start, end = (float(t) for t in value)
+        except (TypeError, ValueError):
+            raise InputError(f"{name} must be a pair (start, end) in seconds; got {value!r}") from None
+        if not 0 <= start < end <= self.duration_s:
+            raise InputError(f"{name} must satisfy 0 <= start < end <= duration_s = {self.duration_s}; "
+                             f"got ({start}, {end})")
+        return start, end
+
+
+def _translate(cls: type, changes: dict[str, Any]) -> dict[str, Any]:
+    """``changes`` with deprecated keywords of ``cls`` renamed (each with a DeprecationWarning)."""
+    out = {}
+    for key, value in changes.items():
+        new = cls.RENAMED.get(key)
+        if new is not None:
+            if new in changes:
+                raise InputError(f"{cls.__name__}: give {new!r} only ({key!r} is its deprecated name)")
+            warnings.warn(f"{cls.__name__}: {key!r} is deprecated, use {new!r}", DeprecationWarning, stacklevel=3)
+            key = new
+        out[key] = value
+    return out
+
+
+def renamed_fields(**renamed: str):
+    """Class decorator (above ``@dataclass``): deprecated field names ``old=new`` kept working for one release.
+
+    The constructor and :meth:`Scenario.replace` accept ``old=`` and the
+    attribute ``scenario.old`` reads ``scenario.new``, each with a
+    :class:`DeprecationWarning`.
+    """
+
+    def wrap(cls):
+        cls.RENAMED = {**cls.RENAMED, **renamed}
+        init = cls.__init__
+
+        @functools.wraps(init)
+        def __init__(self, *args, **kwargs):
+            init(self, *args, **_translate(cls, kwargs))
+
+        cls.__init__ = __init__
+        for old, new in renamed.items():
+            def read(self, old=old, new=new):
+                warnings.warn(f"{type(self).__name__}.{old} is deprecated, use .{new}", DeprecationWarning,
+                              stacklevel=2)
+                return getattr(self, new)
+
+            setattr(cls, old, property(read, doc=f"Deprecated name of :attr:`{new}`."))
+        return cls
+
+    return wrap
