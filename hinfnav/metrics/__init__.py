@@ -1,5 +1,6 @@
 """Metrics layer: error statistics of simulated runs, for any state."""
 
+from .accumulator import StatisticsAccumulator, StatisticsSink, WindowStatistics, group_summary, rms_interval
 from .consistency import (
     DIVERGENCE_FACTOR,
     NEES_FACTOR,
@@ -18,6 +19,7 @@ from .errors import (
     by_group,
     convergence_time,
     group_rms,
+    check_tolerance,
     max_error,
     monte_carlo_summary,
     rms_error,
@@ -25,7 +27,7 @@ from .errors import (
     window_mask,
 )
 from .intervals import format_interval, mean_interval, t_half_width
-from .streaming import MonteCarloStatistics, WindowStatistics, monte_carlo_statistics
+from .streaming import MonteCarloStatistics, monte_carlo_statistics
 
 __all__ = [
     "window_mask",
@@ -33,6 +35,11 @@ __all__ = [
     "rms_per_run",
     "max_error",
     "convergence_time",
+    "check_tolerance",
+    "StatisticsAccumulator",
+    "StatisticsSink",
+    "group_summary",
+    "rms_interval",
     "MonteCarloSummary",
     "monte_carlo_summary",
     "by_group",

@@ -28,7 +28,7 @@ from ..notebooks import run_notebooks
 from .claims import evaluate_claims
 from .constants import CITATION, READING_REASONS, REQUIREMENT_ASD, TABLE2
 from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12
-from .loop import run_closed_loop
+from .loop import run_closed_loop, run_closed_loops
 from .scenario import Scenario, check_scenario
 from .studies import (
     NPERSEG,
@@ -43,7 +43,7 @@ from .studies import (
     truncated,
 )
 
-__all__ = ["reproduce", "READING_RUNS", "reading_study", "integral_study", "algorithm_windows", "to_json",
+__all__ = ["reproduce", "READING_RUNS", "reading_study", "integral_study", "integral_studies", "algorithm_windows", "to_json",
            "execute_notebooks"]
 
 #: Largest runs × steps of one reproduction (the histories of a 3×10⁵-step run take ~0.2 GB).
@@ -101,8 +101,18 @@ def reading_study(scenario, changes, *, n_steps, seed=0, runs=1, settle_s=None, 
 
 def integral_study(scenario, integral, *, n_steps, seed=0):
     """The ADRC loop with the NLPID integral read ``integral``: does it stay put?"""
-    sc = replace(check_scenario(scenario), n_steps=n_steps, integral=integral)
-    res = run_closed_loop(sc, controller="adrc", seed=seed, passive=False)
+    return integral_studies(scenario, (integral,), n_steps=n_steps, seed=seed)[integral]
+
+
+def integral_studies(scenario, integrals, *, n_steps, seed=0):
+    """:func:`integral_study` of each reading in ``integrals``, the loops batched (same noise): name → study."""
+    sc = replace(check_scenario(scenario), n_steps=n_steps)
+    loops = run_closed_loops([(replace(sc, integral=i), "adrc") for i in integrals], seed=seed, passive=False)
+    return {i: _integral_stats(sc, i, res) for i, res in zip(integrals, loops)}
+
+
+def _integral_stats(sc, integral, res):
+    n_steps = sc.n_steps
     k = res.x.shape[1] // 2
     att_err = np.abs(res.x[:, k:, 0:3] - res.reference[k:]).max()
     return {"integral": integral, "n_steps": n_steps,
@@ -151,10 +161,12 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     say = (lambda msg: tqdm.write(msg)) if progress else (lambda msg: None)
     timings = {}
 
-    say(f"yang2020: ADRC closed loop, {sc.n_steps} steps ...")
+    say(f"yang2020: the ADRC, the tuned PID and the ADRC on the PID, one batch of closed loops, {sc.n_steps} steps ...")
     t0 = time.perf_counter()
-    main = run_closed_loop(sc, controller="adrc", runs=runs, seed=seed, passive=True, progress=progress)
-    timings["adrc_loop_with_standalone_filters_s"] = time.perf_counter() - t0
+    kinds = ("adrc", "pid", "adrc_pid")
+    main, *others = run_closed_loops([(sc, kind) for kind in kinds], runs=runs, seed=seed, passive=(True, False, False),
+                                     progress=progress)
+    timings["adrc_pid_adrc_pid_loops_with_standalone_filters_s"] = time.perf_counter() - t0
     n_p = main.passive["L1"].shape[1]
     algorithms = estimation_errors(main, windows=algorithm_windows(n_p, sc.dt))
     closed_l = estimation_errors(main, windows={"all": (0, n_p), "first_100s": (0, min(n_p, 1000))})
@@ -175,12 +187,8 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         _save(fig, out, name, formats, prov)
     main_r = main
 
-    say("yang2020: tuned PID and ADRC on the same PID ...")
     loops9 = {"ADRC (NLPID, Section 3)": main_r}
-    for kind, label in (("pid", "PID (5.55, 0, 9)"), ("adrc_pid", "ADRC (same PID + compensation)")):
-        t0 = time.perf_counter()
-        res = run_closed_loop(sc, controller=kind, runs=runs, seed=seed, passive=False, progress=progress)
-        timings[f"{kind}_loop_s"] = time.perf_counter() - t0
+    for kind, label, res in zip(kinds[1:], ("PID (5.55, 0, 9)", "ADRC (same PID + compensation)"), others):
         k0 = int(sc.settle_s / sc.dt)
         per[kind] = periodic_amplitude(res.x[:, k0:, 6], res.t[k0:], sc.w_d)
         spectra[f"{kind}_test_mass"] = residual_spectrum(res, sc.residual, sc.settle_s)
@@ -188,7 +196,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     _save(fig9(loops9), out, "fig9", formats, prov)
     _save(fig12({"PID": spectra["pid_test_mass"], "ADRC on the PID": spectra["adrc_pid_test_mass"],
                  "ADRC (NLPID)": spectra[sc.residual]}), out, "fig12", formats, prov)
-    del loops9, res, main
+    del loops9, res, main, others
 
     say(f"yang2020: drag-free loop open (Fig 5), {open_loop_steps} steps ...")
     t0 = time.perf_counter()
@@ -205,7 +213,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
     t0 = time.perf_counter()
     for name, changes in tqdm(READING_RUNS.items(), disable=bar_disabled(progress), desc="readings", leave=False):
         by_reading[name] = reading_study(sc, changes, n_steps=n_rec, seed=seed, runs=runs)
-    integral = {i: integral_study(sc, i, n_steps=min(integral_steps, sc.n_steps), seed=seed) for i in ("printed", "dt")}
+    integral = integral_studies(sc, ("printed", "dt"), n_steps=min(integral_steps, sc.n_steps), seed=seed)
     timings["reading_studies_s"] = time.perf_counter() - t0
 
     st = spectra[sc.residual]["stats"]
