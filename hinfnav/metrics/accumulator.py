@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
+from ..sim.engine import Sink
 from .consistency import NIS_KEYS, ConsistencyAccumulator, initial_scale
 from .errors import check_tolerance, convergence_time, window_mask
 from .intervals import t_half_width
@@ -101,7 +102,7 @@ def add_batch(acc: StatisticsAccumulator, start: int, truth: Truth, history: Est
                 history.diagnostics.get(NIS_KEYS[1]), scale0)
 
 
-class StatisticsSink:
+class StatisticsSink(Sink):
     """The engine's sink of streaming statistics: ``result()`` is name → :class:`StatisticsAccumulator`.
 
     Parameters

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -59,14 +59,17 @@ __all__ = ["Sink", "HistorySink", "run_monte_carlo", "truth_batch", "truth_batch
            "results_from_parts"]
 
 
-class Sink(Protocol):
-    """Where :func:`run_monte_carlo` puts each batch."""
+class Sink:
+    """Where :func:`run_monte_carlo` puts each batch (the base of :class:`HistorySink` and
+    :class:`hinfnav.metrics.StatisticsSink`)."""
 
     def add(self, name: str, start: int, truth: Truth, history: EstimateHistory) -> None:
-        """Runs ``start … start + batch − 1`` of estimator ``name``."""
+        """Take runs ``start … start + batch − 1`` of estimator ``name``."""
+        raise NotImplementedError
 
     def result(self) -> Any:
         """What the Monte Carlo returns."""
+        raise NotImplementedError
 
 
 def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int | np.random.SeedSequence:
@@ -371,7 +374,7 @@ def results_from_parts(parts: Sequence[SimulationResult], runs: int) -> Simulati
                             diagnostics=diag, xhat0=first.xhat0)
 
 
-class HistorySink:
+class HistorySink(Sink):
     """Keeps every history: ``result()`` is name → :class:`SimulationResult` of all runs.
 
     Parameters
