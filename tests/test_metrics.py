@@ -56,6 +56,30 @@ def test_convergence_time():
     np.testing.assert_array_equal(convergence_time(e, t, tol=1.0), [4.0, np.nan])
     # a per-component tolerance: 5.0 on x is inside a tolerance of 5 (settled from the start)
     np.testing.assert_array_equal(convergence_time(e, t, tol=[5.0, 1, 1, 1, 1, 1]), [0.0, np.nan])
+    # streaming statistics of runs that may diverge: a NaN counts as outside (run 1: NaN at t = 6, its 9.0 at the
+    # end inside a tolerance of 10: settled from t = 7, counted by hand)
+    e[1, 6, 2] = np.nan
+    with pytest.raises(InputError, match="finite"):
+        convergence_time(e, t, tol=1.0)
+    np.testing.assert_array_equal(convergence_time(e, t, tol=[5.0, 1, 1, 10, 1, 1], nonfinite="outside"), [0.0, 7.0])
+    e[1, :] = 0.0
+    e[1, 2, 2] = np.nan  # NaN at t = 2 only: settled from t = 3 (counted by hand)
+    np.testing.assert_array_equal(convergence_time(e, t, tol=1.0, nonfinite="outside"), [4.0, 3.0])
+
+
+def test_statistics_sink_is_the_accumulator_of_the_engine():
+    # the engine's streaming sink against the histories of the same runs (hinfnav.metrics.rms_error, a
+    # separate computation from full histories): pooled RMS to round-off, per-run convergence times equal
+    from hinfnav.metrics import StatisticsSink
+    from hinfnav.papers.sun2011 import Scenario
+    from hinfnav.sim import HistorySink, run_monte_carlo
+    sc = Scenario(duration_s=20.0, rms_window_s=(0.0, 20.0))
+    win = {"w": (5.0, 20.0)}
+    kw = dict(runs=3, seed=2, batch_size=2, maneuver=True)
+    acc = run_monte_carlo(sc, "ekf", sink=StatisticsSink(win, 3, sc.xhat0, tol=50.0), **kw)["ekf"]
+    hist = run_monte_carlo(sc, "ekf", sink=HistorySink(sc.xhat0, 3), **kw)["ekf"]
+    np.testing.assert_allclose(acc.window_statistics()["w"].pooled, rms_error(hist.error, hist.t, win["w"]), rtol=1e-12)
+    np.testing.assert_array_equal(acc.convergence_s, convergence_time(hist.error, hist.t, 50.0))
 
 
 def test_bad_input():

@@ -200,3 +200,75 @@ def test_shared_covariance_stays_a_view_across_batches(short_scenario):
     assert a.P.shape == (5, s.n_steps + 1, 6, 6) and a.P.strides[0] == 0
     np.testing.assert_allclose(a.P[4], b.P[4], rtol=1e-12, atol=0)
     np.testing.assert_allclose(a.xhat, b.xhat, rtol=1e-12, atol=1e-9)
+
+
+# --- the one Monte Carlo engine (hinfnav.sim.engine) on the four papers' scenarios --------------------------------
+
+def _four_scenarios():
+    from hinfnav.papers import attitude2018, shi2018, sun2011, yang2020
+    return {
+        "sun2011": (sun2011.Scenario(duration_s=20.0, rms_window_s=(0.0, 20.0)), "published", {}),
+        "shi2018": (shi2018.Scenario(duration_s=600.0, window_s=(200.0, 600.0)), "ukf", {"maneuver": True}),
+        "attitude2018": (attitude2018.Scenario().short(0.02), "aekf", {}),
+        "yang2020": (yang2020.Scenario(n_steps=200), "yang2020_fused", {}),
+    }
+
+
+def _hand_truth(sc, conditions, seed, runs):
+    """The true states by a plain loop written here: run r's w then v from the r-th child of ``seed``, the state
+    moved by Φ x + Γ K x + B w (a LinearSystem) or by the system's step under the truth model's law (nonlinear)."""
+    model = sc.truth_model(**{k: v for k, v in conditions.items() if k != "maneuver"})
+    system, n1 = model.system, model.n_steps + 1
+    out = np.empty((runs, n1, system.n))
+    for r, rng in enumerate(np.random.default_rng(seed).spawn(runs)):
+        w = rng.standard_normal((n1, system.n_noise))
+        x = out[r]
+        x[0] = model.x0
+        for k in range(n1 - 1):
+            if hasattr(system, "Phi"):
+                u = np.zeros(system.n_input) if model.controller is None else model.controller.K @ x[k]
+                x[k + 1] = system.Phi @ x[k] + system.Gamma @ u + system.B @ w[k]
+            else:
+                u = np.zeros((1, system.n_input)) if model.controller is None else model.controller(x[k][None])
+                x[k + 1] = system.step(x[k][None], u, w[k][None], model.time[k])[0]
+    if conditions.get("maneuver"):
+        out += sc.maneuver_response()  # Shi & Wang's target impulse at 500 s (the scenario's own truth)
+    return out
+
+
+@pytest.mark.parametrize("paper", ["sun2011", "shi2018", "attitude2018", "yang2020"])
+def test_simulate_runs_on_each_papers_scenario(paper):
+    sc, est, cond = _four_scenarios()[paper]
+    res = simulate(sc, est, runs=2, seed=3, batch_size=1, **cond)
+    model_n = len(sc.xhat0)
+    assert res.xhat.shape == res.x.shape and res.x.shape[0] == 2 and res.x.shape[2] == model_n
+    err = res.error
+    assert err.shape[:2] == res.x.shape[:2] and np.all(np.isfinite(err))
+    # the truth against an independent loop (plain numpy, written in this test); round-off only
+    np.testing.assert_allclose(res.x, _hand_truth(sc, cond, 3, 2), rtol=1e-9, atol=1e-9 * np.abs(res.x).max())
+    assert res.settings["runs"] == 2 and res.settings["filter"] == est
+
+
+def test_engine_several_estimators_share_one_truth_and_batches_do_not_matter():
+    from hinfnav.sim import HistorySink, run_monte_carlo
+    sc, _, _ = _four_scenarios()["sun2011"]
+    out = run_monte_carlo(sc, ["published", "ekf"], sink=HistorySink(sc.xhat0, 3), runs=3, seed=5, batch_size=2,
+                          maneuver=True)
+    a, b = out["published"], out["ekf"]
+    np.testing.assert_array_equal(a.x, b.x)  # common random numbers: one truth for both estimators
+    one = simulate(sc, "ekf", runs=3, seed=5, batch_size=3, maneuver=True)
+    # batch size 2 or 3: the same numbers (each run from its own generator), matrix-product round-off aside
+    np.testing.assert_allclose(one.xhat, b.xhat, rtol=1e-9, atol=1e-9 * np.abs(b.xhat).max())
+    assert a.settings["filter"] == "published" and b.settings["runs"] == 3
+    with pytest.raises(InputError, match="twice"):
+        run_monte_carlo(sc, ["ekf", "ekf"], sink=HistorySink(sc.xhat0, 1))
+
+
+def test_closed_loop_with_the_law_on_the_truth_is_the_open_loop_truth():
+    # the engine's closed loop, its controller fed the true state, must give simulate_truth's x (the same draws)
+    from hinfnav.sim import simulate_closed_loop
+    sc, _, _ = _four_scenarios()["sun2011"]
+    model = sc.truth_model(maneuver=True)
+    ideal = simulate_closed_loop(sc, "ekf", model.controller, runs=2, seed=4, batch_size=1, maneuver=True)
+    np.testing.assert_allclose(ideal.x, simulate_truth(model, runs=2, seed=4).x, rtol=1e-12, atol=1e-9)
+    assert ideal.settings["feedback"] == "truth"

@@ -11,7 +11,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hinfnav.papers.yang2020 import Scenario, residual_acceleration, run_closed_loop, saturation_summary
+from hinfnav.core.exceptions import InputError
+from hinfnav.papers.yang2020 import Scenario, residual_acceleration, run_closed_loop, run_closed_loops, saturation_summary
 from hinfnav.papers.yang2020.constants import D_TRANS, K_TRANS, M_SC, M_TM
 
 SC = Scenario(n_steps=800, step_on=300, step_off=600)
@@ -84,3 +85,19 @@ def test_passive_filters_shapes(loop):
     assert all(v.shape == (2, SC.n_steps + 1, 9) for v in loop.passive.values())
     short = run_closed_loop(replace(SC, n_steps=200), passive=True, passive_steps=50)
     assert short.passive["L2"].shape == (1, 50, 9)
+
+
+def test_batched_variants_equal_their_own_loops(loop):
+    # run_closed_loops steps several controllers as rows of one batch; each variant must give the numbers of its
+    # own run_closed_loop (the reference: the loop run alone), round-off aside, whatever the other rows do
+    sc_i = replace(SC, integral="dt")
+    batched = run_closed_loops([(SC, "adrc"), (SC, "pid"), (sc_i, "adrc")], runs=2, seed=11,
+                               passive=(True, False, False))
+    assert _same(batched[0].x, loop.x) and _same(batched[0].xhat, loop.xhat)
+    assert _same(batched[0].passive["L1"], loop.passive["L1"]) and batched[1].passive == {}
+    for res, (sc, kind) in zip(batched[1:], ((SC, "pid"), (sc_i, "adrc"))):
+        alone = run_closed_loop(sc, controller=kind, runs=2, seed=11, passive=False)
+        assert _same(res.x, alone.x) and _same(res.u, alone.u)
+        assert res.settings["clipped_input_steps"] == alone.settings["clipped_input_steps"]
+    with pytest.raises(InputError, match="differs"):
+        run_closed_loops([(SC, "adrc"), (replace(SC, noise="two_sided"), "adrc")])

@@ -42,7 +42,6 @@ from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 from tqdm import tqdm
 
 from ..core.exceptions import HinfnavError, InputError
@@ -50,12 +49,11 @@ from ..io.outputs import MARKER, check_output_dir, output_lock, to_json
 from ..io.progress import bar_disabled
 from ..io.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
-from ..metrics.consistency import NIS_KEYS, initial_scale, warn_if_diverged
-from ..sim.montecarlo import check_measurement_match
-from ..sim.truth import simulate_truth
+from ..metrics.accumulator import StatisticsAccumulator, add_batch
+from ..metrics.consistency import NIS_KEYS, warn_if_diverged
+from ..sim.engine import estimate_on_truth, truth_batches, truth_runs
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
-from .stats import CellAccumulator
 from .table import results_table
 
 if TYPE_CHECKING:
@@ -142,7 +140,6 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     _BUILT.update(unit.get("built", {}))  # the estimators built (and designed) once by the validation
     t_start, c_start = time.perf_counter(), time.process_time()
     scenario = _scenario(unit["scenario"], unit["settings"])
-    model = scenario.truth_model(**unit["conditions"])
     runs, bs = unit["runs"], unit["batch_size"]
     cells = unit["cells"]
     estimators, accs, errors = {}, {}, {}
@@ -152,32 +149,34 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
         try:
             estimators[c["cell_id"]] = _estimator(scenario, unit["scenario"], unit["settings"], c["estimator"],
                                                   c["options"])
-            accs[c["cell_id"]] = CellAccumulator(unit["windows"], runs, unit["tol"])
+            accs[c["cell_id"]] = StatisticsAccumulator(unit["windows"], runs, unit["tol"])
         except Exception as exc:
             errors[c["cell_id"]] = f"{type(exc).__name__}: {exc}"
         elapsed[c["cell_id"]] += time.perf_counter() - t0
         cpu[c["cell_id"]] += time.process_time() - c0
     truth_s = truth_cpu = 0.0
-    for start in range(0, runs, bs):
-        n = min(bs, runs - start)
+    batches = truth_batches(scenario, unit["conditions"], runs=runs, batch_size=bs, seed=unit["seed"],
+                            noise=unit["noise"])
+    while True:  # the engine's open loop, with each cell's failures and time kept apart
         t0, c0 = time.perf_counter(), time.process_time()
-        truth = simulate_truth(model, noise=unit["noise"], runs=n, seed=unit["seed"], first_run=start)
+        batch = next(batches, None)
         truth_s += time.perf_counter() - t0
         truth_cpu += time.process_time() - c0
+        if batch is None:
+            break
+        start, truth = batch
         for c in cells:
             cid = c["cell_id"]
             if cid in errors:
                 continue
             t0, c0 = time.perf_counter(), time.process_time()
             try:
-                est = estimators[cid]
-                check_measurement_match(est, truth.measurement)
-                _run_cell_batch(est, truth, scenario.xhat0, accs[cid], start)
+                _run_cell_batch(estimators[cid], truth, scenario.xhat0, accs[cid], start)
             except Exception as exc:
                 errors[cid] = f"{type(exc).__name__}: {exc}"
             elapsed[cid] += time.perf_counter() - t0
             cpu[cid] += time.process_time() - c0
-        del truth
+        del truth, batch
     out = []
     for c in cells:
         cid = c["cell_id"]
@@ -197,23 +196,12 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
 
 
 def _run_cell_batch(est, truth, xhat0, acc, start):
-    """Run one estimator on one truth batch, in chunks of runs whose histories fit :data:`CONSISTENCY_BYTES`."""
-    runs, n1, n = truth.x.shape
-    m = truth.y.shape[-1]
-    chunk = max(1, min(runs, CONSISTENCY_BYTES // (8 * n1 * (n * n + m * m + m))))
-    error = (lambda x, xh: x - xh) if truth.state is None else truth.state.error
-    for s in range(0, runs, chunk):
-        sl = slice(s, min(s + chunk, runs))
-        hist = est.estimate(truth.y[sl], truth.u[sl], xhat0, keep_covariance=True, diagnostics=NIS_KEYS)
-        x = truth.x[sl]
-        with np.errstate(all="ignore"):
-            err = error(x, hist.xhat)
-            P = hist.P if hist.P is not None and hist.P.ndim == 4 else None
-            scale0 = initial_scale(error(x[:, 0], np.broadcast_to(np.asarray(xhat0, dtype=float), x[:, 0].shape)),
-                                   None if P is None else P[:, 0], err[:, 0])
-            acc.add(start + s, truth.t, err, truth.state, P, hist.diagnostics.get(NIS_KEYS[0]),
-                    hist.diagnostics.get(NIS_KEYS[1]), scale0)
-        del hist, err, P
+    """Run one estimator on one truth batch into the cell's accumulator (the engine's
+    :func:`~hinfnav.sim.engine.estimate_on_truth`, in chunks of runs whose histories fit :data:`CONSISTENCY_BYTES`)."""
+    for off, hist in estimate_on_truth(est, truth, xhat0, keep_covariance=True, diagnostics=NIS_KEYS,
+                                       max_bytes=CONSISTENCY_BYTES):
+        add_batch(acc, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist, xhat0)
+        del hist
 
 
 class CellResults(tuple):

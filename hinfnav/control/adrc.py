@@ -179,12 +179,41 @@ class DragFreeADRC:
         self._slope = np.where(self._linear, 1.0, self._delta ** (self._alpha - 1.0))
         self._zone = float(np.min(np.where(self._linear, np.inf, self._delta)))  # all |e| below: g(e) = slope e
         self._has_i = bool(np.any(self._ki > 0))
+        self._comp_rows = None  # per-row compensation of stacked laws (:meth:`stacked`)
         self._pos = np.r_[0:3, 9:12, 18:21]
         self._rate = np.r_[3:6, 12:15, 21:24]
 
     def start(self, runs: int) -> NDArray[np.float64]:
         """Zero integrators e_i of the nine channels (attitude, drag-free, relative attitude): shape (runs, 9)."""
         return np.zeros((int(runs), 9))
+
+    @classmethod
+    def stacked(cls, laws: list[DragFreeADRC], runs: int) -> DragFreeADRC:
+        """Several laws as one on stacked rows: rows ``v·runs … (v+1)·runs − 1`` follow ``laws[v]``.
+
+        The laws must share the plant (inertias, masses, couplings) and the bound; their loop gains,
+        integral readings and compensation may differ. Each row's input is the one its own law gives
+        (the same arithmetic, element by element), computed in one call for all rows.
+        """
+        if not laws or not all(isinstance(law, cls) for law in laws):
+            raise InputError("laws must be a non-empty list of DragFreeADRC")
+        first = laws[0]
+        for law in laws[1:]:
+            if law.bound != first.bound or any(not np.array_equal(getattr(law, k), getattr(first, k))
+                                               for k in ("I_sc", "I_tm", "_h_idf", "_h_itm")):
+                raise InputError("stacked laws must share the plant (inertias, couplings) and the bound")
+        out = cls.__new__(cls)
+        out.__dict__.update(first.__dict__)
+        runs = int(runs)
+        rows = lambda name: np.repeat(np.stack([getattr(law, name) for law in laws]), runs, axis=0)
+        for name in ("_kp", "_ki", "_kd", "_iscale", "_alpha", "_delta", "_linear", "_slope"):
+            setattr(out, name, rows(name))
+        out._any_linear = bool(out._linear.any())
+        out._zone = min(law._zone for law in laws)
+        out._has_i = any(law._has_i for law in laws)
+        out._comp_rows = np.repeat([law.dragfree_compensation for law in laws], runs)
+        out.dragfree_compensation = bool(out._comp_rows.any())
+        return out
 
     def __call__(self, xhat, attitude_ref, state):
         """Inputs ``u = [T_Csc, F_Csc, T_Ctm]`` for a batch of estimates.
@@ -218,7 +247,10 @@ class DragFreeADRC:
             u0 = u0 + self._ki * g[2]
         u = np.empty((xhat.shape[0], 9))
         u[:, 0:3] = u0[:, 0:3] @ self.I_sc.T - xhat[:, 6:9]
-        if self.dragfree_compensation:
+        if self._comp_rows is not None:  # stacked laws: compensation per row
+            u[:, 3:6] = np.where(self._comp_rows[:, None], -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18],
+                                 -u0[:, 3:6])
+        elif self.dragfree_compensation:
             u[:, 3:6] = -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18]
         else:
             u[:, 3:6] = -u0[:, 3:6]

@@ -28,6 +28,7 @@ __all__ = [
     "rms_per_run",
     "max_error",
     "convergence_time",
+    "check_tolerance",
     "MonteCarloSummary",
     "monte_carlo_summary",
     "by_group",
@@ -119,8 +120,19 @@ def max_error(error: ArrayLike, t: ArrayLike, window: Sequence[float]) -> NDArra
     return np.max(np.abs(error[:, mask]), axis=(0, 1))
 
 
-def convergence_time(error: ArrayLike, t: ArrayLike, tol: ArrayLike) -> NDArray[np.float64]:
-    """Time after which every error component stays within its tolerance.
+def check_tolerance(tol: ArrayLike, n: int) -> NDArray[np.float64]:
+    """Per-component tolerance (one number or ``n``), finite and > 0, as an array of shape (n,)."""
+    tol = _float_array("tol", tol)
+    if tol.ndim > 1 or tol.size not in (1, n):
+        raise InputError(f"tol must be one number or one per component ({n}); got shape {tol.shape}")
+    tol = np.broadcast_to(tol, (n,))
+    if not np.all(np.isfinite(tol)) or np.any(tol <= 0):
+        raise InputError(f"tol must be finite and > 0 for every component; got {tol}")
+    return tol
+
+
+def convergence_time(error: ArrayLike, t: ArrayLike, tol: ArrayLike, *, nonfinite: str = "refuse") -> NDArray[np.float64]:
+    """Time after which every error component stays within its tolerance (the package's one convergence time).
 
     Parameters
     ----------
@@ -128,29 +140,32 @@ def convergence_time(error: ArrayLike, t: ArrayLike, tol: ArrayLike) -> NDArray[
     t : array_like, shape (n_samples,)
     tol : array_like, shape (n,) or float
         Tolerance of each component, in its units (> 0).
+    nonfinite : {"refuse", "outside"}
+        A NaN or infinite error is refused (InputError), or counts as outside
+        the tolerance (streaming statistics of runs that may diverge).
 
     Returns
     -------
     ndarray, shape (runs,)
         The first t_k from which ``|e_i(t_j)| <= tol_i`` for all j ≥ k and all
-        components; ``nan`` for a run that never settles.
+        components; ``nan`` for a run that never settles (outside at the last sample).
     """
-    error, t = _check_error(error, t)
-    tol = _float_array("tol", tol)
-    if tol.ndim > 1 or tol.size not in (1, error.shape[2]):
-        raise InputError(f"tol must be one number or one per component ({error.shape[2]}); got shape {tol.shape}")
-    tol = np.broadcast_to(tol, (error.shape[2],))
-    if not np.all(np.isfinite(tol)) or np.any(tol <= 0):
-        raise InputError(f"tol must be finite and > 0 for every component; got {tol}")
-    outside = np.any(np.abs(error) > tol, axis=2)  # (runs, n)
-    out = np.full(error.shape[0], np.nan)
+    if nonfinite not in ("refuse", "outside"):
+        raise InputError(f"nonfinite must be 'refuse' or 'outside'; got {nonfinite!r}")
+    if nonfinite == "refuse":
+        error, t = _check_error(error, t)
+    else:
+        error, t = _float_array("error", error), _float_array("t", t)
+        if error.ndim != 3 or t.shape != (error.shape[1],):
+            raise InputError(f"error must have shape (runs, n_samples, n) and t (n_samples,); got {error.shape}, {t.shape}")
+    tol = check_tolerance(tol, error.shape[2])
+    with np.errstate(invalid="ignore"):
+        outside = ~np.all(np.abs(error) <= tol, axis=2)  # (runs, n_samples); NaN is outside
     n = t.size
-    for r in range(error.shape[0]):
-        idx = np.flatnonzero(outside[r])
-        if idx.size == 0:
-            out[r] = t[0]
-        elif idx[-1] < n - 1:
-            out[r] = t[idx[-1] + 1]
+    last = np.where(outside.any(axis=1), n - 1 - np.argmax(outside[:, ::-1], axis=1), -1)
+    out = np.full(error.shape[0], np.nan)
+    ok = last < n - 1
+    out[ok] = t[last[ok] + 1]
     return out
 
 

@@ -1,4 +1,4 @@
-"""Simulation layer: open-loop truth, closed loop, Monte Carlo with seeding and batching."""
+"""Simulation layer: truths (linear and nonlinear), the one Monte Carlo engine and its uses."""
 
 from typing import TYPE_CHECKING
 
@@ -6,7 +6,9 @@ from ..core.lazy import lazy_exports
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .closed_loop import simulate_closed_loop
-    from .montecarlo import SimulationResult, resolve_estimator, run_estimator, simulate, simulate_batches
+    from .engine import HistorySink, Sink, run_monte_carlo
+    from .montecarlo import resolve_estimator, run_estimator, simulate, simulate_batches
+    from .result import SimulationResult
     from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
 
 __all__ = [
@@ -19,6 +21,9 @@ __all__ = [
     "run_estimator",
     "resolve_estimator",
     "simulate_closed_loop",
+    "run_monte_carlo",
+    "HistorySink",
+    "Sink",
     "child_rngs",
     "noise_models",
     "draw_noise",

@@ -2,7 +2,8 @@
 
 ::
 
-    x(k+1) = Φ x(k) + Γ u(k) + B w(k),    u(k) = K x(k) (or none)
+    x(k+1) = Φ x(k) + Γ u(k) + B w(k),    u(k) = K x(k) (or none)       (a LinearSystem)
+    x(k+1) = step(x(k), u(k), w(k), t_k), u(k) = controller(x(k)) (or 0) (a nonlinear system)
     y(k)   = h(x(k)) + D v(k)
 
 w and v are unit-variance noise sequences from :mod:`hinfnav.noise`. A
@@ -202,23 +203,33 @@ def simulate_truth(model: TruthModel, *, noise: str | NoiseModel = "gaussian", m
     runs = as_int_at_least("runs", runs, 1)
     first_run = as_int_at_least("first_run", first_run, 0)
     system, meas = model.system, model.measurement
+    ctrl = model.controller
+    if ctrl is not None and getattr(ctrl, "source", "truth") != "truth":
+        raise InputError("simulate_truth takes feedback on the true state only; use simulate_closed_loop for u = K x̂")
+    linear = callable(getattr(system, "transition_matrix", None)) and (ctrl is None or hasattr(ctrl, "K"))
+    if not linear and not callable(getattr(system, "step", None)):
+        raise InputError(f"model.system must be a LinearSystem or offer step(x, u, w, t); got {type(system).__name__}")
     w_model, v_model = noise_models(noise, measurement_noise, system.dt)
     n1 = model.n_steps + 1
     rngs = child_rngs(seed, first_run + runs)[first_run:]
     w, v = draw_noise(w_model, v_model, rngs, n1, system.n_noise, meas.n_noise)
-    K = None
-    if model.controller is not None:
-        if model.controller.source != "truth":
-            raise InputError("simulate_truth takes feedback on the true state only; use simulate_closed_loop for u = K x̂")
-        K = model.controller.K
-    Acl = system.transition_matrix(K)
     x = np.empty((runs, n1, system.n))
     x[:, 0] = model.x0
-    drive = w @ system.B.T
-    AclT = Acl.T
-    for k in range(n1 - 1):
-        x[:, k + 1] = x[:, k] @ AclT + drive[:, k]
-    u = x @ K.T if K is not None else np.zeros((runs, n1, system.n_input))
+    if linear:
+        K = None if ctrl is None else ctrl.K
+        AclT = system.transition_matrix(K).T
+        drive = w @ system.B.T
+        for k in range(n1 - 1):
+            x[:, k + 1] = x[:, k] @ AclT + drive[:, k]
+        u = x @ K.T if K is not None else np.zeros((runs, n1, system.n_input))
+    else:  # x(k+1) = step(x(k), u(k), w(k), t_k), u(k) = controller(x(k)) (or 0)
+        u = np.zeros((runs, n1, system.n_input))
+        t = model.time
+        for k in range(n1):
+            if ctrl is not None:
+                u[:, k] = ctrl(x[:, k])
+            if k < n1 - 1:
+                x[:, k + 1] = system.step(x[:, k], u[:, k], w[:, k], t[k])
     y = meas.measure(x, v)
     settings = dict(model.settings)
     settings.update(

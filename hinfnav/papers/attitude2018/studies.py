@@ -23,8 +23,7 @@ from tqdm import tqdm
 from ...core.validation import as_int_at_least
 from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
-from ...sim.nonlinear import simulate_nonlinear_truth
-from ...sim.truth import Truth
+from ...sim.truth import Truth, simulate_truth
 from .constants import (
     DEFAULT_AA,
     DEFAULT_ST,
@@ -303,7 +302,7 @@ def attitude_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, Qs=Q_SWEE
     runs = as_int_at_least("runs", runs, 1)
     sweep_runs = min(runs, 4) if sweep_runs is None else min(as_int_at_least("sweep_runs", sweep_runs, 1), runs)
     bar = tqdm(total=9, disable=not progress, desc="attitude2018", unit="pass")
-    truth = simulate_nonlinear_truth(scenario.truth_model(), runs=runs, seed=seed)
+    truth = simulate_truth(scenario.truth_model(), runs=runs, seed=seed)
     small = first_runs(truth, sweep_runs)
     bar.update(1)
     eps0 = default_epsilon(omega_e=scenario.omega_e)
@@ -343,7 +342,7 @@ def sweep_study(scenario=None, *, runs=2, seed=0, filters=("aekf",), Qs=Q_SWEEP)
     For notebooks that show claims 1–2 without the cost of the whole study.
     """
     scenario = Scenario() if scenario is None else scenario
-    truth = simulate_nonlinear_truth(scenario.truth_model(), runs=as_int_at_least("runs", runs, 1), seed=seed)
+    truth = simulate_truth(scenario.truth_model(), runs=as_int_at_least("runs", runs, 1), seed=seed)
     Qs = [float(q) for q in Qs]
     labels = [f"Q={q:.0e}" for q in Qs]
     builders = {"aekf": build_aekf, "astekf": build_astekf}

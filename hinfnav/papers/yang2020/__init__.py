@@ -13,7 +13,7 @@ from .claims import evaluate_claims, format_claims
 from .constants import CITATION, READING_REASONS, READINGS, REQUIREMENT_ASD, TABLE2
 from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12, plot_asd, plot_series, plot_truncated_update
 from .filters import ESTIMATOR_NAMES, L_MODES, SUBSYSTEM_OF, build_alg1, build_alg2, build_fused
-from .loop import PASSIVE, LoopResult, residual_acceleration, run_closed_loop
+from .loop import PASSIVE, LoopResult, residual_acceleration, run_closed_loop, run_closed_loops
 from .model import (
     DRAGFREE_INDICES,
     DragFreeModel,
@@ -68,6 +68,7 @@ __all__ = [
     "L_MODES",
     "LoopResult",
     "run_closed_loop",
+    "run_closed_loops",
     "residual_acceleration",
     "PASSIVE",
     "NPERSEG",

@@ -29,12 +29,14 @@ in blocks of ``BLOCK`` steps, w (9) then d (9) then d_a (3) per block: the same
 seed gives the same numbers whatever the number of runs.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from tqdm import tqdm
 
+from ...core.exceptions import InputError
 from ...io.progress import bar_disabled
+from ...control.adrc import DragFreeADRC
 from ...core.validation import as_choice, as_int_at_least
 from ...sim.truth import child_rngs
 from .constants import ACCELEROMETER_RANGE, D_TRANS, K_TRANS, M_SC, M_TM
@@ -42,7 +44,7 @@ from .filters import build_alg1, build_alg2, build_fused
 from .model import MEASURED_INDICES, disturbance
 from .scenario import CONTROLLERS, check_scenario
 
-__all__ = ["LoopResult", "run_closed_loop", "residual_acceleration", "Alg2Bank", "BLOCK", "PASSIVE"]
+__all__ = ["LoopResult", "run_closed_loop", "run_closed_loops", "CONTROLLER_FIELDS", "residual_acceleration", "Alg2Bank", "BLOCK", "PASSIVE"]
 
 #: Steps per block of noise drawn at once.
 BLOCK = 10_000
@@ -186,7 +188,7 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
     ----------
     scenario : Scenario
         Length, readings, ``steady_tol`` (gains frozen once converged).
-    controller : {"adrc", "adrc_pid", "pid"}
+    controller : {"adrc", "adrc_pid", "pid", "dragfree_off"}
     runs : int
     seed : int or numpy.random.Generator
     passive : bool
@@ -199,48 +201,112 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
     -------
     LoopResult
     """
-    sc = check_scenario(scenario)
-    as_choice("controller", controller, CONTROLLERS)
+    return run_closed_loops([(scenario, controller)], runs=runs, seed=seed, passive=passive,
+                            passive_steps=passive_steps, progress=progress)[0]
+
+
+#: Scenario fields that only the controller (``integral``) or the post-processing (``residual``) reads: loops that
+#: differ only in these (and in the controller) share the plant, the noise and the estimator and are batched.
+CONTROLLER_FIELDS = ("integral", "residual")
+
+
+def _check_variants(variants):
+    """The scenarios and controllers of ``variants``, checked to share everything but the controller."""
+    if isinstance(variants, (str, bytes)) or not hasattr(variants, "__iter__"):
+        raise InputError("variants must be a sequence of (scenario, controller) pairs")
+    variants = list(variants)
+    if not variants:
+        raise InputError("variants must hold at least one (scenario, controller) pair")
+    out = []
+    for i, pair in enumerate(variants):
+        if not isinstance(pair, tuple) or len(pair) != 2:
+            raise InputError(f"variants[{i}] must be a (scenario, controller) pair; got {pair!r}")
+        sc = check_scenario(pair[0])
+        out.append((sc, as_choice("controller", pair[1], CONTROLLERS)))
+    blank = {key: "off" if key == "integral" else "test_mass" for key in CONTROLLER_FIELDS}
+    common = replace(out[0][0], **blank)
+    for i, (sc, _) in enumerate(out[1:], 1):
+        if replace(sc, **blank) != common:
+            raise InputError(f"variants[{i}]'s scenario differs from variants[0]'s beyond {CONTROLLER_FIELDS}: "
+                             "only loops on the same plant, noise and estimator are batched")
+    return out
+
+
+def run_closed_loops(variants, *, runs=1, seed=0, passive=True, passive_steps=100_000, progress=False):
+    """Several closed loops of Section 3 on the same plant and noise, stepped together as rows of one batch.
+
+    Each variant ``(scenario, controller)`` is one loop of :func:`run_closed_loop`; the scenarios may differ only
+    in :data:`CONTROLLER_FIELDS`. Row ``v * runs + r`` is run r of variant v and draws from the r-th child of the
+    seed in the order of the module docstring, so every variant's numbers equal those of its own
+    :func:`run_closed_loop` (round-off aside: the rows share the matrix products) whatever the other variants:
+    common random numbers, and the per-step Python work is paid once for all the loops.
+
+    Parameters
+    ----------
+    variants : sequence of (Scenario, str)
+        The loops: scenario and controller (``CONTROLLERS``).
+    runs : int
+        Monte Carlo runs of every variant.
+    seed : int or numpy.random.Generator
+    passive : bool or sequence of bool
+        Run the standalone estimators alongside (all variants, or per variant).
+    passive_steps : int
+    progress : bool
+
+    Returns
+    -------
+    list of LoopResult
+        One per variant, in order.
+    """
+    pairs = _check_variants(variants)
+    nv = len(pairs)
     runs = as_int_at_least("runs", runs, 1)
+    flags = [bool(passive)] * nv if np.ndim(passive) == 0 else [bool(p) for p in passive]
+    if len(flags) != nv:
+        raise InputError(f"passive must be one bool or {nv} (one per variant); got {len(flags)}")
     if isinstance(seed, np.random.Generator):
         seed = int(seed.integers(2**63))
     rngs = child_rngs(seed, runs)
+    sc = pairs[0][0]
     m = sc.model
     n1 = sc.n_steps + 1
+    rows = nv * runs
     t = np.arange(n1) * sc.dt
     f = disturbance(t, sc.w_d)
     ref = sc.attitude_reference(n1)
-    law = sc.controller(controller)
+    law = DragFreeADRC.stacked([s.controller(kind) for s, kind in pairs], runs)  # one call for every row
+    slices = [slice(v * runs, (v + 1) * runs) for v in range(nv)]
     fused = build_fused(sc, steady_tol=sc.steady_tol)
     lo, up = ACCELEROMETER_RANGE
     sd_w, sd_d, sd_a = sc.input_std, sc.sensor_std, sc.accel_std
     PhiT, GamT, CaT = m.Phi.T, m.Gamma.T, m.accel_C.T
 
-    x_h = np.empty((runs, n1, 18))
-    u_h, g_h, xhat_h, acc_h = (np.empty((runs, n1, k)) for k in (9, 9, 27, 3))
-    clipped = 0
-    n_passive = min(n1, as_int_at_least("passive_steps", passive_steps, 0)) if passive else 0
-    pas = {name: np.empty((runs, n_passive, 9)) for name in PASSIVE} if n_passive else {}
+    x_h = np.empty((rows, n1, 18))
+    u_h, g_h, xhat_h, acc_h = (np.empty((rows, n1, k)) for k in (9, 9, 27, 3))
+    clipped = np.zeros(nv, dtype=int)
+    n_passive = min(n1, as_int_at_least("passive_steps", passive_steps, 0)) if any(flags) else 0
+    prow = np.concatenate([np.arange(rows)[sl] for sl, fl in zip(slices, flags) if fl]) if n_passive else None
+    pas = {name: np.empty((prow.size, n_passive, 9)) for name in PASSIVE} if n_passive else {}
     if n_passive:
         a1 = build_alg1(sc, steady_tol=sc.steady_tol)
-        s1 = a1.start(sc.xhat0, None, runs)
-        bank = Alg2Bank(build_alg2(sc, mode="truncated"), runs)
-    x = np.broadcast_to(sc.x0, (runs, 18)).copy()
-    fs = fused.start(sc.xhat0, None, runs)
-    cs = law.start(runs)
+        s1 = a1.start(sc.xhat0, None, prow.size)
+        bank = Alg2Bank(build_alg2(sc, mode="truncated"), prow.size)
+        all_passive = prow.size == rows
+    x = np.broadcast_to(sc.x0, (rows, 18)).copy()
+    fs = fused.start(sc.xhat0, None, rows)
+    cs = law.start(rows)
     prior = sc.timing == "prior"
-    u_prev = np.zeros((runs, 9))  # input and input noise of the hold interval that ends at t_k
-    w_prev = np.zeros((runs, 9))
+    u_prev = np.zeros((rows, 9))  # input and input noise of the hold interval that ends at t_k
+    w_prev = np.zeros((rows, 9))
     steady_at = None
-    for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({controller})", unit="step",
-                  mininterval=1.0, leave=False):
+    for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({', '.join(p[1] for p in pairs)})",
+                  unit="step", mininterval=1.0, leave=False):
         j = k % BLOCK
         if j == 0:
             nb = min(BLOCK, n1 - k)
             blocks = [[rng.standard_normal((nb, p)) for p in (9, 9, 3)] for rng in rngs]
-            W = np.stack([b[0] for b in blocks]) * sd_w
-            Dn = np.stack([b[1] for b in blocks]) * sd_d
-            Da = np.stack([b[2] for b in blocks]) * sd_a
+            W, Dn, Da = (np.tile(np.stack([b[i] for b in blocks]) * sd, (nv, 1, 1))
+                         for i, sd in enumerate((sd_w, sd_d, sd_a)))
         fk, wk = f[k], W[:, j]
         if prior:
             u, ucmd, cs = law(fs.x, ref[k], cs)
@@ -254,22 +320,37 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
         fs, out = fused.update(fs, np.concatenate([Y, a_c], axis=1))
         if not prior:
             u, ucmd, cs = law(out.xhat, ref[k], cs)
-        if np.any(u != ucmd):
-            clipped += 1
+        if nv == 1:
+            clipped[0] += bool(np.any(u != ucmd))
+        else:
+            clipped += np.any((u != ucmd).reshape(nv, -1), axis=1)
         g = u + wk + fk
         if steady_at is None and fs.extra["steady"] is not None:
             steady_at = k
         x_h[:, k], u_h[:, k], g_h[:, k], xhat_h[:, k], acc_h[:, k] = x, u, g, out.xhat, a_raw
         if k < n_passive:
-            s1, o1 = a1.update(s1, Y)
+            Yp, up_, ur, ar, ac = ((Y, u, u_read, a_raw, a_c) if all_passive else
+                                   (Y[prow], u[prow], u_read[prow], a_raw[prow], a_c[prow]))
+            s1, o1 = a1.update(s1, Yp)
             pas["alg1"][:, k] = o1.xhat[:, 9:18]
-            s1 = a1.predict(s1, u)
-            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(a_raw, a_c, u_read[:, 3:6], u[:, 3:6])
+            s1 = a1.predict(s1, up_)
+            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(ar, ac, ur[:, 3:6], up_[:, 3:6])
         fs = fused.predict(fs, u)
         x = x @ PhiT + g @ GamT
         u_prev, w_prev = u, wk
-    settings = dict(sc.readings, controller=controller, runs=runs, seed=seed, n_steps=sc.n_steps, dt=sc.dt, w_d=sc.w_d,
-                    steady_tol=sc.steady_tol, fused_steady_from_step=steady_at, clipped_input_steps=clipped,
-                    theta_alg1=float(fused.alg1.theta), theta_alg2=fused.alg2.theta.tolist())
-    return LoopResult(t=t, x=x_h, f=f, u=u_h, drive=g_h, acc=acc_h, xhat=xhat_h, passive=pas, reference=ref,
-                      settings=settings)
+    results = []
+    first = 0
+    for v, ((s, kind), sl) in enumerate(zip(pairs, slices)):
+        settings = dict(s.readings, controller=kind, runs=runs, seed=seed, n_steps=s.n_steps, dt=s.dt, w_d=s.w_d,
+                        steady_tol=s.steady_tol, fused_steady_from_step=steady_at,
+                        clipped_input_steps=int(clipped[v]), theta_alg1=float(fused.alg1.theta),
+                        theta_alg2=fused.alg2.theta.tolist())
+        if flags[v] and n_passive:
+            pv = {name: h[first:first + runs] for name, h in pas.items()}
+            first += runs
+        else:
+            pv = {}
+        results.append(LoopResult(t=t, x=x_h[sl], f=f, u=u_h[sl], drive=g_h[sl], acc=acc_h[sl], xhat=xhat_h[sl],
+                                  passive=pv, reference=ref, settings=settings))
+    return results
+
