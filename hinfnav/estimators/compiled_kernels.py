@@ -78,6 +78,33 @@ def _mv(A, x):
 
 
 @njit(cache=True)
+def _lin(a, X, b, Y):
+    """a X + b Y (1-D or 2-D arrays of one shape), a new array."""
+    out = np.empty_like(X)
+    xf, yf, of = X.ravel(), Y.ravel(), out.ravel()
+    for i in range(xf.size):
+        of[i] = a * xf[i] + b * yf[i]
+    return out
+
+
+@njit(cache=True)
+def _eye_minus(B):
+    """I − B."""
+    out = -B
+    for i in range(B.shape[0]):
+        out[i, i] += 1.0
+    return out
+
+
+@njit(cache=True)
+def _maxabs(x):
+    s = 0.0
+    for v in x:
+        s = max(s, abs(v))
+    return s
+
+
+@njit(cache=True)
 def _sym(A):
     n = A.shape[0]
     for i in range(n):
@@ -225,57 +252,74 @@ def _psi(z, gamma):
 
 
 @njit(cache=True)
+def _residual(M, x, yv):
+    """M x − y."""
+    z = _mv(M, x)
+    for i in range(z.size):
+        z[i] -= yv[i]
+    return z
+
+
+@njit(cache=True)
+def _innovation(H, x, yk):
+    """y − H x."""
+    z = _mv(H, x)
+    for i in range(z.size):
+        z[i] = yk[i] - z[i]
+    return z
+
+
+@njit(cache=True)
 def _minimise(M, yv, x, gamma, tol, max_iter):
     """:func:`hinfnav.estimators.huber_regression.minimise` for one regression; returns x."""
     r, n = M.shape
+    MT = M.T.copy()
     slack = 1e-12 * gamma
     x = x.copy()
+    d = np.empty(r)
+    g = np.empty(r)
     for _ in range(max_iter):
-        zeta = _mv(M, x) - yv
-        quad = np.abs(zeta) <= gamma
+        zeta = _residual(M, x, yv)
+        psi = _psi(zeta, gamma)
         nq = 0
-        g = np.empty(r)
         for i in range(r):
-            if quad[i]:
+            if abs(zeta[i]) <= gamma:
                 nq += 1
                 g[i] = zeta[i]
             else:
                 g[i] = gamma * np.sign(zeta[i])
-        grad = _mv(M.T.copy(), g)
-        psi = _psi(zeta, gamma)
+        grad = _mv(MT, g)
         cands = np.empty((len(_BETAS), n))
         exact = False
         for b in range(len(_BETAS)):
             beta = _BETAS[b]
-            d = np.where(quad, 1.0, beta * psi)
+            for i in range(r):
+                d[i] = 1.0 if abs(zeta[i]) <= gamma else beta * psi[i]
             dx, ok = _scaled_solve(_normal(M, d), grad, (nq >= n) if beta == 0.0 else True)
-            cands[b] = x - dx
-            if beta == 0.0:
-                if ok:
-                    zc = _mv(M, cands[0]) - yv
-                    exact = True
-                    for i in range(r):
-                        if quad[i]:
-                            if not abs(zc[i]) <= gamma + slack:
-                                exact = False
-                        elif not np.sign(zeta[i]) * zc[i] >= gamma - slack:
+            cands[b] = _lin(1.0, x, -1.0, dx)
+            if beta == 0.0 and ok:
+                zc = _residual(M, cands[0], yv)
+                exact = True
+                for i in range(r):
+                    if abs(zeta[i]) <= gamma:
+                        if not abs(zc[i]) <= gamma + slack:
                             exact = False
+                    elif not np.sign(zeta[i]) * zc[i] >= gamma - slack:
+                        exact = False
                 if exact:
-                    break
-        if exact:
-            return cands[0]
+                    return cands[0]
         # IRLS step (weights psi) and the backtracked Newton candidates: the cheapest is kept
-        Mw = _normal(M, psi)
-        rhs = _mv(M.T.copy(), psi * yv)
-        xn, _ = _scaled_solve(Mw, rhs, True)
-        step = np.max(np.abs(_mv(M, xn - x)))
+        for i in range(r):
+            g[i] = psi[i] * yv[i]
+        xn, _ = _scaled_solve(_normal(M, psi), _mv(MT, g), True)
+        step = _maxabs(_mv(M, _lin(1.0, xn, -1.0, x)))
         best = xn
-        best_cost = _huber_cost(_mv(M, xn) - yv, gamma)
+        best_cost = _huber_cost(_residual(M, xn, yv), gamma)
         for b in range(len(_BETAS)):
             f = 1.0
             for _t in range(_N_BACKTRACK):
-                trial = x + (cands[b] - x) * f
-                cost = _huber_cost(_mv(M, trial) - yv, gamma)
+                trial = _lin(1.0 - f, x, f, cands[b])
+                cost = _huber_cost(_residual(M, trial, yv), gamma)
                 if cost < best_cost:
                     best, best_cost = trial, cost
                 f *= 0.5
@@ -297,21 +341,20 @@ def _huber_correct(P, A, e, gamma, tol, max_iter):
     PAT = _mmt(P, A)
     C = _mm(A, PAT)
     _sym(C)
-    S = C + np.eye(m)
+    S = _eye_minus(-C)
     Si, ok = _spd_inv(S)
     if not ok:
         return np.zeros(n), P, False
     c = _mv(Si, e)
     dx = _mv(PAT, c)
-    zm = _mv(C, c) - e
+    zm = _residual(C, c, e)
     L_P, ok = _chol(P)
     if not ok:
         return dx, P, False
     LPi = _tri_inv(L_P)
     zp = _mv(LPi, dx)
-    inside = np.all(np.abs(zm) <= gamma) and np.all(np.abs(zp) <= gamma)
-    if inside:
-        Pp = P - _mmt(_mm(PAT, Si), PAT)
+    if _maxabs(zm) <= gamma and _maxabs(zp) <= gamma:
+        Pp = _lin(1.0, P, -1.0, _mmt(_mm(PAT, Si), PAT))
         _sym(Pp)
         return dx, Pp, True
     M = np.empty((m + n, n))
@@ -320,7 +363,7 @@ def _huber_correct(P, A, e, gamma, tol, max_iter):
     yv = np.zeros(m + n)
     yv[:m] = e
     dx = _minimise(M, yv, dx, gamma, tol, max_iter)
-    w = _psi(_mv(M, dx) - yv, gamma)
+    w = _psi(_residual(M, dx, yv), gamma)
     Pp, ok = _spd_inv(_normal(M, w))
     return dx, Pp, ok
 
@@ -332,13 +375,13 @@ def _joseph(P, H, R, nu, symmetrize):
     """(J1)-(J2): ``(dx, P⁺, K, ok)``."""
     n = P.shape[0]
     PHT = _mmt(P, H)
-    S = _mm(H, PHT) + R
+    S = _lin(1.0, _mm(H, PHT), 1.0, R)
     Si, ok = _spd_inv(S)
     if not ok:
         return np.zeros(n), P, PHT, False
     K = _mm(PHT, Si)
-    IKH = np.eye(n) - _mm(K, H)
-    Pp = _mmt(_mm(IKH, P), IKH) + _mmt(_mm(K, R), K)
+    IKH = _eye_minus(_mm(K, H))
+    Pp = _lin(1.0, _mmt(_mm(IKH, P), IKH), 1.0, _mmt(_mm(K, R), K))
     if symmetrize:
         _sym(Pp)
     return _mv(K, nu), Pp, K, True
@@ -349,7 +392,7 @@ def _fade(PPT, Qd, H, R, V0, beta, a):
     """(S2)-(S4): ``P(k+1|k) = Λ^{1/2} Φ P Φᵀ Λ^{1/2} + Q_d``."""
     n = PPT.shape[0]
     m = H.shape[0]
-    N = V0 - beta * R - _mmt(_mm(H, Qd), H)
+    N = _lin(1.0, V0, -1.0, _lin(beta, R, 1.0, _mmt(_mm(H, Qd), H)))
     trN = 0.0
     for i in range(m):
         trN += N[i, i]
@@ -369,6 +412,35 @@ def _fade(PPT, Qd, H, R, V0, beta, a):
         for j in range(n):
             P[i, j] = sl[i] * PPT[i, j] * sl[j] + Qd[i, j]
     return P
+
+
+@njit(cache=True)
+def _moment(V0, nu, rho, first):
+    """(S1): γγᵀ at the first reading, else (ρ V₀ + γγᵀ)/(1 + ρ)."""
+    m = nu.size
+    V = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            gg = nu[i] * nu[j]
+            V[i, j] = gg if first else (rho * V0[i, j] + gg) / (1.0 + rho)
+    return V
+
+
+@njit(cache=True)
+def _propagate(F, G, u, x, use_input):
+    """F x (+ G u)."""
+    out = _mv(F, x)
+    if use_input:
+        gu = _mv(G, u)
+        for i in range(out.size):
+            out[i] += gu[i]
+    return out
+
+
+@njit(cache=True)
+def _store(xhat, r, k, x, n_rep):
+    for i in range(n_rep):
+        xhat[r, k, i] = x[i]
 
 
 @njit(cache=True)
@@ -398,19 +470,14 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
             K_seq[k] = K
             _record(Pp if filtered else P, n_rep, 0, k, Pdiag, Pfull, keep)
             if k < steps - 1:
-                P = _mmt(_mm(F, Pp), F) + Qd
+                P = _lin(1.0, _mmt(_mm(F, Pp), F), 1.0, Qd)
         for r in range(runs):
             x = x0.copy()
             for k in range(steps):
-                nu = y[r, k] - _mv(H, x)
-                xp = x + _mv(K_seq[k], nu)
-                xr = xp if filtered else x
-                for i in range(n_rep):
-                    xhat[r, k, i] = xr[i]
+                xp = _lin(1.0, x, 1.0, _mv(K_seq[k], _innovation(H, x, y[r, k])))
+                _store(xhat, r, k, xp if filtered else x, n_rep)
                 if k < steps - 1:
-                    x = _mv(F, xp)
-                    if use_input:
-                        x += _mv(G, u[r, k])
+                    x = _propagate(F, G, u[r, k], xp, use_input)
         return True
     A = _mm(LRi, H) if huber else H
     for r in range(runs):
@@ -419,10 +486,9 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
         PPT = P0
         V0 = np.zeros((m, m))
         for k in range(steps):
-            nu = y[r, k] - _mv(H, x)
+            nu = _innovation(H, x, y[r, k])
             if strong and k > 0:
-                gg = np.outer(nu, nu)
-                V0 = gg if k == 1 else (rho[r] * V0 + gg) / (1.0 + rho[r])
+                V0 = _moment(V0, nu, rho[r], k == 1)
                 P = _fade(PPT, Qd, H, R, V0, beta[r], a)
             if huber:
                 dx, Pp, ok = _huber_correct(P, A, _mv(LRi, nu), gamma, tol, max_iter)
@@ -430,17 +496,13 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
                 dx, Pp, _, ok = _joseph(P, H, R, nu, symmetrize)
             if not ok or not _finite(Pp) or not _finite(dx):
                 return False
-            xp = x + dx
-            xr = xp if filtered else x
-            for i in range(n_rep):
-                xhat[r, k, i] = xr[i]
+            xp = _lin(1.0, x, 1.0, dx)
+            _store(xhat, r, k, xp if filtered else x, n_rep)
             _record(Pp if filtered else P, n_rep, r, k, Pdiag, Pfull, keep)
             if k < steps - 1:
-                x = _mv(F, xp)
-                if use_input:
-                    x += _mv(G, u[r, k])
+                x = _propagate(F, G, u[r, k], xp, use_input)
                 PPT = _mmt(_mm(F, Pp), F)
-                P = PPT + Qd
+                P = _lin(1.0, PPT, 1.0, Qd)
     return True
 
 
@@ -476,6 +538,24 @@ def _wcov(Wc, A, B):
 
 
 @njit(cache=True)
+def _shift_rows(X, v, sign):
+    """Rows of X plus (sign 1) or minus (sign −1) v, in place."""
+    for s in range(X.shape[0]):
+        for i in range(X.shape[1]):
+            X[s, i] += sign * v[i]
+
+
+@njit(cache=True)
+def _weighted_mean(W, X, ref):
+    """ref + Σ W_s (X_s − ref) (ref zero: the weighted mean)."""
+    out = ref.copy()
+    for s in range(X.shape[0]):
+        for i in range(X.shape[1]):
+            out[i] += W[s] * (X[s, i] - ref[i])
+    return out
+
+
+@njit(cache=True)
 def sigma_point_batch(F, G, H, Q, R, P0, x0, y, u, use_input, filtered, Wm, Wc, scale, center, keep, xhat, Pdiag,
                       Pfull):
     """(U1)-(U5) on a linear model, every run and step; fills xhat, Pdiag/Pfull; ok."""
@@ -488,51 +568,42 @@ def sigma_point_batch(F, G, H, Q, R, P0, x0, y, u, use_input, filtered, Wm, Wc, 
             dX, ok = _offsets(P, scale, center)
             if not ok:
                 return False
-            N = dX.shape[0]
             Y = _mmt(dX, H)  # H (x + δ) = H x + H δ
             yx = _mv(H, x)
-            for s in range(N):
-                Y[s] += yx
-            ref = Y[0].copy() if center else yx
-            ym = ref.copy()
-            for s in range(N):
-                ym += Wm[s] * (Y[s] - ref)
-            dY = Y.copy()
-            for s in range(N):
-                dY[s] -= ym
-            S = _wcov(Wc, dY, dY) + R
-            Pxy = _wcov(Wc, dX, dY)
+            _shift_rows(Y, yx, 1.0)
+            ym = _weighted_mean(Wm, Y, Y[0].copy() if center else yx)
+            _shift_rows(Y, ym, -1.0)
+            S = _lin(1.0, _wcov(Wc, Y, Y), 1.0, R)
             Si, ok = _spd_inv(S)
             if not ok:
                 return False
-            K = _mm(Pxy, Si)
-            xp = x + _mv(K, y[r, k] - ym)
-            Pp = P - _mmt(_mm(K, S), K)
+            K = _mm(_wcov(Wc, dX, Y), Si)
+            xp = _lin(1.0, x, 1.0, _mv(K, _lin(1.0, y[r, k], -1.0, ym)))
+            Pp = _lin(1.0, P, -1.0, _mmt(_mm(K, S), K))
             _sym(Pp)
-            xr, Pr = (xp, Pp) if filtered else (x, P)
-            for i in range(n):
-                xhat[r, k, i] = xr[i]
-            _record(Pr, n, r, k, Pdiag, Pfull, keep)
+            _store(xhat, r, k, xp if filtered else x, n)
+            _record(Pp if filtered else P, n, r, k, Pdiag, Pfull, keep)
             if k < steps - 1:
                 dX, ok = _offsets(Pp, scale, center)
                 if not ok:
                     return False
                 Xf = _mmt(dX, F)  # F (x + δ) + G u
-                base = _mv(F, xp)
-                if use_input:
-                    base += _mv(G, u[r, k])
-                for s in range(N):
-                    Xf[s] += base
-                x = np.zeros(n)
-                for s in range(N):
-                    x += Wm[s] * Xf[s]
-                for s in range(N):
-                    Xf[s] -= x
-                P = _wcov(Wc, Xf, Xf) + Q
+                _shift_rows(Xf, _propagate(F, G, u[r, k], xp, use_input), 1.0)
+                x = _weighted_mean(Wm, Xf, np.zeros(n))
+                _shift_rows(Xf, x, -1.0)
+                P = _lin(1.0, _wcov(Wc, Xf, Xf), 1.0, Q)
     return True
 
 
 # -- the recursive H-infinity filter ------------------------------------------------------
+
+@njit(cache=True)
+def _frobenius(A):
+    s = 0.0
+    for v in A.ravel():
+        s += v * v
+    return np.sqrt(s)
+
 
 @njit(cache=True)
 def recursive_hinf_batch(F, G, H, Q, Gm, HtRi, P0, x0, y, u, use_input, freeze, keep, xhat, Pdiag, Pfull):
@@ -542,38 +613,31 @@ def recursive_hinf_batch(F, G, H, Q, Gm, HtRi, P0, x0, y, u, use_input, freeze, 
     FK = np.empty((steps, n, m))
     P = P0.copy()
     steady = False
-    FKs = np.empty((n, m))
     for k in range(steps):
         _record(P, n, 0, k, Pdiag, Pfull, keep)
         if steady:
-            FK[k] = FKs
+            FK[k] = FK[k - 1]
             continue
         C, ok = _chol(P)
         if not ok:
             return False
-        N = np.eye(n) + _mm(_mm(C.T.copy(), Gm), C)
+        N = _eye_minus(-_mm(_mm(C.T.copy(), Gm), C))
         _sym(N)
         Nc, ok = _chol(N)
         if not ok:
             return False
         CNC = _mm(C, _chol_solve(Nc, C.T.copy()))
         _sym(CNC)
-        K = _mm(CNC, HtRi)
-        FK[k] = _mm(F, K)
-        Pn = _mmt(_mm(F, CNC), F) + Q
+        FK[k] = _mm(F, _mm(CNC, HtRi))
+        Pn = _lin(1.0, _mmt(_mm(F, CNC), F), 1.0, Q)
         _sym(Pn)
-        if np.linalg.norm(Pn - P) <= freeze * np.linalg.norm(P):
+        if _frobenius(_lin(1.0, Pn, -1.0, P)) <= freeze * _frobenius(P):
             steady = True
-            FKs = FK[k].copy()
         else:
             P = Pn
     for r in range(runs):
         x = x0.copy()
         for k in range(steps):
-            for i in range(n):
-                xhat[r, k, i] = x[i]
-            nu = y[r, k] - _mv(H, x)
-            x = _mv(F, x) + _mv(FK[k], nu)
-            if use_input:
-                x += _mv(G, u[r, k])
+            _store(xhat, r, k, x, n)
+            x = _lin(1.0, _propagate(F, G, u[r, k], x, use_input), 1.0, _mv(FK[k], _innovation(H, x, y[r, k])))
     return True
