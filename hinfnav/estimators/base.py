@@ -48,6 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_vector
+from .compiled import run_compiled, select_backend
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -393,7 +394,8 @@ class Estimator:
     # -- batch --------------------------------------------------------------
 
     def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
-                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False) -> EstimateHistory:
+                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False,
+                 backend: str = "numpy") -> EstimateHistory:
         """Estimate the state histories of a batch of runs.
 
         Parameters
@@ -413,6 +415,9 @@ class Estimator:
         diagnostics : bool or iterable of str
             Return the diagnostics histories: all (True), none (False), or
             those named.
+        backend : {"numpy", "numba", "auto"}
+            The NumPy step loop (the reference), a compiled kernel, or the
+            kernel where one exists (see :mod:`hinfnav.estimators.compiled`).
 
         Returns
         -------
@@ -421,6 +426,10 @@ class Estimator:
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
+        if select_backend(self, backend, keys) == "numba":
+            xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
+            if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says
+                return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks

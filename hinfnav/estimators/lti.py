@@ -12,6 +12,7 @@ from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
+from .compiled import select_backend
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -122,8 +123,10 @@ class LTIFilter(Estimator):
         return FilterState(x=x, k=state.k + 1)
 
     def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
-                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False) -> EstimateHistory:
-        """Vectorized over runs and fast: same numbers as the step loop (bitwise)."""
+                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False,
+                 backend: str = "numpy") -> EstimateHistory:
+        """Vectorized over runs and fast: same numbers as the step loop (bitwise); no compiled kernel."""
+        select_backend(self, backend)  # "numba" is refused (no kernel); "auto" is this NumPy path
         history_keys(keep_covariance, diagnostics)  # checked; the filter has neither a covariance nor diagnostics
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
