@@ -322,13 +322,11 @@ class ExtendedKalmanFilter(KalmanCore):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         F = None
+        t = state.k * self.dt
         if self.nonlinear_dynamics:  # the Jacobian at the posterior x̂(k|k), before the mean moves on
-            t = state.k * self.dt
             F = np.asarray(self.system.jacobian(state.x, u if self.uses_input else None, t), dtype=float)
-            x = self.predict_mean(state.x, u, t)
-        else:
-            x = self.predict_mean(state.x, u)
-        extra = {key: val for key, val in state.extra.items() if key not in _TRANSIENT}
+        x = self.predict_mean(state.x, u, t)
+        extra = {key: val for key, val in state.extra.items() if key not in self.transient_keys}
         if self.defers_prior:  # F P Fᵀ and Q_d kept for complete_prior at the next reading
             PhiPPhiT = self.propagated_covariance(state.P, F)
             Qd, e_noise = self.process_noise(state)
