@@ -11,9 +11,9 @@ from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHub
 from .extended_state import ExtendedStateKalmanFilter
 from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
 from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
-from .huber_filter import HuberCorrection, HuberFilter
+from .huber_filter import HuberCorrection, HuberFilter, HuberStrongTrackingEKF
 from .recursive_hinf import RecursiveHInfinityFilter
-from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, StrongTrackingEKF
+from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
 from .lti import LTIFilter
 from .sigma_point import SigmaPointFilter
 from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -44,6 +44,8 @@ __all__ = [
     "SigmaPointFilter",
     "StrongTracking",
     "StrongTrackingEKF",
+    "HuberStrongTrackingEKF",
+    "RateAdaptiveEKF",
     "RateAdaptive",
     "AugmentedEKF",
     "AugmentedInputKF",

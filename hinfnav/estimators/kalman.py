@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
-from .adaptive import StrongTracking
+from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 
@@ -50,7 +50,7 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "StrongTrackingEKF"]
+__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "RateAdaptiveEKF", "StrongTrackingEKF"]
 
 #: What ``update`` reports at t_k: x̂(k|k) or x̂(k|k−1).
 OUTPUTS = ("filtered", "predicted")
@@ -350,3 +350,16 @@ class StrongTrackingEKF(StrongTracking, ExtendedKalmanFilter):
     """
 
     name = "stekf"
+
+
+class RateAdaptiveEKF(RateAdaptive, ExtendedKalmanFilter):
+    """Rate-adapted process noise on :class:`ExtendedKalmanFilter` (R1)–(R2).
+
+    On a linear system or any dynamics model; parameters of
+    :class:`ExtendedKalmanFilter` and ``states``, ``window``, ``epsilon``,
+    ``floor`` of :class:`~hinfnav.estimators.adaptive.RateAdaptive` (the
+    diagonal entries of Q at ``states`` follow their states' estimated rate).
+    Diagnostics ``q_adapted`` and ``input_rate`` (runs, len(states)).
+    """
+
+    name = "aekf_rate"
