@@ -10,7 +10,7 @@ from .adaptive import RateAdaptive, StrongTracking
 from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
 from .extended_state import ExtendedStateKalmanFilter
 from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
-from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
+from .correction import KalmanCorrection, drop_missing, joseph_covariance, joseph_update, kalman_gain
 from .huber_filter import HuberCorrection, HuberFilter, HuberStrongTrackingEKF
 from .recursive_hinf import RecursiveHInfinityFilter
 from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
@@ -34,6 +34,7 @@ __all__ = [
     "HuberCorrection",
     "KalmanCorrection",
     "joseph_update",
+    "joseph_covariance",
     "kalman_gain",
     "drop_missing",
     "AugmentedInputHuberSTKF",

@@ -21,7 +21,7 @@ from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput
-from .correction import drop_missing
+from .correction import drop_missing, joseph_covariance, kalman_gain
 from .extended_state import ExtendedStateKalmanFilter, check_steady_tol, predicted_increment
 from .steady import freeze_gain
 
@@ -136,8 +136,9 @@ class SaturatedExtendedStateFilter(Estimator):
         meas = Saturated(LinearMeasurement(Cm, np.diag(np.sqrt(self.Reff)), labels=measurement_labels,
                                            units=measurement_units), self.lower, self.upper)
         super().__init__(system, meas, name=name, missing=missing)
-        self._I3 = np.eye(3)
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
+        self._Crow = self.C[:, None, :]  # (axes, 1, 3): H of each axis
+        self._Rcol = self.Reff[:, None, None]  # (axes, 1, 1): R of each axis
 
     # -- array kernels (runs, n_axes, 3) -------------------------------------------------
 
@@ -193,9 +194,9 @@ class SaturatedExtendedStateFilter(Estimator):
             K, P_post = cache
             innov = y - yhat
             return X + K * innov[..., None], P_post, innov, sat, K
-        K = (P @ self._Ccol)[..., 0]  # P Cᵀ, (runs, axes, 3)
-        Sy = (K[..., None, :] @ self._Ccol)[..., 0, 0] + self.Reff
-        K = K / Sy[..., None]
+        Kc, P_post, Sy = kalman_gain(P, self._Crow, self._Rcol, symmetrize=False)  # (J1)-(J2) per axis
+        K, Sy = Kc[..., 0], Sy[..., 0, 0]
+        modified = False
         y_eff = y
         extra_var = None
         if any_sat:
@@ -213,13 +214,13 @@ class SaturatedExtendedStateFilter(Estimator):
                 extra_var[trunc] = v
             if skip_sat.any():  # keep the prediction on a skipped reading
                 K = np.where(skip_sat[..., None], 0.0, K)
+                modified = True
         innov = y_eff - yhat
         X_post = X + K * innov[..., None]
-        IKC = self._I3 - K[..., :, None] * self.C[:, None, :]
-        KKt = K[..., :, None] * K[..., None, :]
-        P_post = IKC @ P @ np.swapaxes(IKC, -1, -2) + self.Reff[:, None, None] * KKt
+        if modified:  # (J2) with the gain of the readings used
+            P_post = joseph_covariance(P, K[..., :, None], self._Crow, self._Rcol, symmetrize=False)
         if extra_var is not None:
-            P_post = P_post + extra_var[..., None, None] * KKt
+            P_post = P_post + extra_var[..., None, None] * (K[..., :, None] * K[..., None, :])
         return X_post, P_post, innov, sat, K
 
     def kernel_predict(self, X: NDArray[np.float64], P: NDArray[np.float64] | None, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
