@@ -70,7 +70,7 @@ class KalmanCore(KalmanCorrection, Estimator):
     in error coordinates), ``report``/``report_covariance`` (what a step
     returns), ``correct``/``correct_error`` (the Joseph update (J1)-(J2), or
     Huber's), ``measurement_covariance`` (R_k), ``complete_prior`` (strong
-    tracking), ``after_update`` and the diagnostics hooks.
+    tracking), ``after_update``/``after_predict`` and the diagnostics hooks.
     """
 
     #: True when the covariance depends on the data (a mixin's Huber weights, fading factors …)
@@ -137,6 +137,10 @@ class KalmanCore(KalmanCorrection, Estimator):
 
     def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
         """Extra items to keep after an update (none here)."""
+        return {}
+
+    def after_predict(self, state: FilterState, P: NDArray[np.float64]) -> dict[str, Any]:
+        """Extra items to keep after a prediction to P(k+1|k) (none here; a gain freeze keeps its record)."""
         return {}
 
     def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -336,6 +340,7 @@ class ExtendedKalmanFilter(KalmanCore):
             P = self.predict_covariance(state.P, state, F=F)
         else:
             P = self.predict_covariance(state.P, state)
+        extra.update(self.after_predict(state, P))
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
 

@@ -22,7 +22,7 @@ from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput
 from .correction import drop_missing, joseph_covariance, kalman_gain
-from .extended_state import ExtendedStateKalmanFilter, check_steady_tol, predicted_increment
+from .extended_state import ExtendedStateKalmanFilter, check_steady_tol
 from .steady import freeze_gain
 
 __all__ = ["SaturatedExtendedStateFilter", "FusedExtendedStateFilter", "MODES", "FUSED_COVARIANCES"]
@@ -432,9 +432,7 @@ class FusedExtendedStateFilter(Estimator):
     def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
         a1 = self.alg1
-        x1 = a1.predict_mean(state.x, u)
-        if a1.nominal is not None:
-            x1 = x1 + predicted_increment(a1.nominal, state.k, a1._q_sqrt) @ a1.B_e.T
+        x1 = a1.predict_mean(state.x, u, state.k * a1.dt)  # Algorithm 1's hook (with the nominal increment (9))
         u2 = u[:, self.uidx]
         steady = state.extra["steady"]
         extra = dict(state.extra, u_feed=np.zeros_like(u2))
