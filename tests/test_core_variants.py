@@ -228,3 +228,13 @@ def test_rate_adaptive_noise_on_the_ekf_equals_a_hand_computation():
     np.testing.assert_allclose(hist.xhat[0], np.array(ref_x), rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(hist.diagnostics["q_adapted"][0, 1:, 0], ref_q, rtol=1e-10)
     assert max(ref_q) > 10 * Q0[1, 1]  # the speed change did raise the noise: the adaptation was exercised
+
+
+def test_rate_adaptive_names_the_states_it_needs():
+    from hinfnav.core.exceptions import InputError
+    from hinfnav.estimators import RateAdaptiveEKF
+
+    with pytest.raises(InputError, match="states"):
+        RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0)
+    with pytest.raises(InputError, match="states"):
+        RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0, states=[2, 7])
