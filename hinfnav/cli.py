@@ -22,7 +22,8 @@ __all__ = ["main", "simulate_report", "format_simulate_report", "FILTER_CHOICES"
 #: ``simulate --filter`` choices: every registered estimator that fits Sun 2011's scenario (tested).
 FILTER_CHOICES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                   "designed_observer_closed_loop", "ekf", "ekf_known_input", "recursive_hinf", "hbf", "ukf",
-                  "ekf_augmented_thrust", "ekf_augmented_thrust_st", "ekf_augmented_thrust_adaptive")
+                  "ekf_augmented_thrust", "ekf_augmented_thrust_st", "ekf_augmented_thrust_adaptive", "stekf",
+                  "huber_stekf")
 #: ``--noise`` choices (= hinfnav.noise.NOISE_NAMES).
 NOISE_CHOICES = ("gaussian", "colored", "mixture", "uniform", "laplace", "student_t")
 #: ``design --solver`` choices (= hinfnav.lmi.SOLVERS).

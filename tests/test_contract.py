@@ -96,6 +96,10 @@ def test_every_paper_filter_is_registered():
     assert set(YANG_NAMES) <= set(registered_estimators(YANG))
     assert {"aekf", "astekf", "aaekf"} <= set(registered_estimators(ATTITUDE))
     assert {"hbf", "ekf_converted"} <= set(registered_estimators(SHI))
+    # the Kalman-core variants (issue 17): strong tracking and Huber x strong tracking where a Kalman filter fits
+    for sc in (SCENARIO, SHI):
+        assert {"ukf", "stekf", "huber_stekf"} <= set(registered_estimators(sc))
+    assert not {"stekf", "huber_stekf"} & set(registered_estimators(ATTITUDE) + registered_estimators(YANG))
 
 
 def test_yang2020_registered_for_the_paper_and_only_there():
