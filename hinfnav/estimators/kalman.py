@@ -14,8 +14,14 @@ variants override small hooks:
   :class:`~hinfnav.estimators.AugmentedEKF`: a filter whose class sets
   ``defers_prior`` keeps ``F P Fᵀ`` and ``Q`` from ``predict`` and completes
   P(k+1|k) when y(k+1) arrives, so the mixins of
-  :mod:`hinfnav.estimators.adaptive` (strong tracking) work on both cores,
-  on a linear system or any dynamics model;
+  :mod:`hinfnav.estimators.adaptive` (strong tracking, rate-adapted noise)
+  work on both cores, on a linear system or any dynamics model
+  (:class:`StrongTrackingEKF`, :class:`RateAdaptiveEKF`);
+* :meth:`~ExtendedKalmanFilter.predict_mean` — ``Φ x̂ + Γ u`` or ``f(x̂, u, t)``
+  (Algorithm 1 adds its predicted disturbance increment, the GRACE filter
+  propagates the mean through a two-body model), and
+  :meth:`~KalmanCore.after_predict` — items kept after a prediction (a
+  steady-gain freeze's record, :mod:`hinfnav.estimators.steady`);
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
 * :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
