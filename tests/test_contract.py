@@ -127,10 +127,12 @@ def test_same_seed_same_numbers_whatever_the_batch(case):
     b = case.simulate(case.estimator, runs=2, seed=3)
     np.testing.assert_array_equal(a.xhat, b.xhat)
     c = case.simulate(case.estimator, runs=2, seed=3, batch_size=1)  # the same runs, one at a time
-    # identity (same computation); tolerance covers BLAS blocking differences (which a loop closed on the
-    # estimate carries into the true state)
-    np.testing.assert_allclose(c.x, a.x, rtol=1e-12, atol=1e-15 * np.abs(a.x).max())
-    np.testing.assert_allclose(c.xhat, a.xhat, rtol=1e-12, atol=1e-15 * np.abs(a.xhat).max())
+    # identity (same computation) up to rounding: BLAS blocks a batch of 1 and of 2 differently, and ~300 steps
+    # (a loop closed on the estimate carries it into the true state) grow that to at most ~1e-12 of each
+    # component's scale (measured 7e-13); a different seed or run order would differ at O(1) of it
+    for new, old in ((c.x, a.x), (c.xhat, a.xhat)):
+        scale = np.abs(old).max(axis=(0, 1))
+        assert np.all(np.abs(new - old) <= 1e-11 * scale), (case.name, np.abs(new - old).max(axis=(0, 1)), scale)
 
 
 def test_run_by_run_equals_vectorized(case):
