@@ -21,7 +21,6 @@ from hinfnav.estimators.adaptive import (
     input_rate,
     rate_adapted_density,
 )
-from hinfnav.noise import NoiseModel
 from hinfnav.papers.attitude2018 import (
     ATTITUDE_FILTERS,
     CHASER_FILTERS,
@@ -32,17 +31,10 @@ from hinfnav.papers.attitude2018 import (
     build_augmented_thrust,
 )
 from hinfnav.papers.sun2011 import Scenario as ChaserScenario
-from hinfnav.sim.nonlinear import simulate_nonlinear, simulate_nonlinear_truth
+from hinfnav.sim.nonlinear import simulate_nonlinear_truth
 
 SC = Scenario(orbits=0.05)  # 293 steps of 1 s
 BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}
-
-
-class ZeroNoise(NoiseModel):
-    name = "zero"
-
-    def _sample(self, rng, shape):
-        return np.zeros(shape)
 
 
 @pytest.fixture(scope="module")
@@ -108,7 +100,8 @@ def test_parameter_sweep_batched_as_runs_equals_runs_one_by_one(truth):
         build_aekf(SC, Q=[1e-16, 1e-14]).estimate(truth.y, truth.u, SC.xhat0)
 
 
-# -- the contract, locally (these filters do not fit the chaser scenario of tests/test_contract.py) ----------
+# -- attitude-specific checks; the contract itself (seed, batch, run by run, step loop, convergence without noise,
+# bad input) runs over these filters in tests/test_contract.py ------------------------------------------------
 
 
 def test_shapes_labels_and_diagnostics(est, truth):
@@ -121,48 +114,6 @@ def test_shapes_labels_and_diagnostics(est, truth):
     if extra:
         assert hist.diagnostics[extra].shape[:2] == truth.x.shape[:2]
     np.testing.assert_allclose(np.linalg.norm(hist.xhat[..., :4], axis=-1), 1.0, atol=1e-12)
-
-
-def test_same_seed_same_numbers_whatever_the_batch(est):
-    a = simulate_nonlinear(SC, est, runs=3, seed=5, batch_size=3)
-    b = simulate_nonlinear(SC, est, runs=3, seed=5, batch_size=1)
-    np.testing.assert_array_equal(a.x, b.x)
-    np.testing.assert_allclose(a.xhat, b.xhat, rtol=1e-12, atol=1e-15)
-
-
-def test_run_by_run_and_step_loop_equal_the_batch(est, truth):
-    batch = est.estimate(truth.y, truth.u, SC.xhat0).xhat
-    for r in range(3):
-        one = est.estimate(truth.y[r:r + 1], truth.u[r:r + 1], SC.xhat0).xhat[0]
-        np.testing.assert_allclose(one, batch[r], rtol=1e-12, atol=1e-15)
-    state = est.start(SC.xhat0, None, 3)
-    xs = np.empty_like(batch)
-    for k in range(truth.x.shape[1]):
-        state, out = est.update(state, truth.y[:, k])
-        xs[:, k] = out.xhat
-        if k < truth.x.shape[1] - 1:
-            state = est.predict(state, truth.u[:, k])
-    np.testing.assert_allclose(xs, batch, rtol=1e-12, atol=1e-15)
-
-
-def test_converges_without_noise(est):
-    # limit 0: no measurement noise, a negligible torque (T0 = 1e-12 N m); initial errors ~1e-2 rad
-    sc = Scenario(orbits=0.1, T0=1e-12)
-    res = simulate_nonlinear(sc, BUILDERS[est.name](sc), runs=1, noise=ZeroNoise())
-    e = np.abs(res.error[0, -1])
-    assert np.all(e[:3] < 1e-9) and np.all(e[3:6] < 1e-10) and np.all(e[6:] < 1e-11), e
-
-
-@pytest.mark.parametrize("change, word", [
-    (lambda y, u, x0: (y[:, :, :5], u, x0), "y"),
-    (lambda y, u, x0: (y, u[:, :-1], x0), "u"),
-    (lambda y, u, x0: (y, u, x0[:9]), "xhat0"),
-    (lambda y, u, x0: (np.where(np.arange(y.shape[1])[None, :, None] == 2, np.nan, y), u, x0), "y"),
-], ids=["y-channels", "u-length", "xhat0-size", "y-nan"])
-def test_bad_input_names_the_parameter(est, truth, change, word):
-    y, u, x0 = change(truth.y, truth.u, SC.xhat0)
-    with pytest.raises(hn.InputError, match=rf"\b{word}\b"):
-        est.estimate(y, u, x0)
 
 
 def test_registry_fits():

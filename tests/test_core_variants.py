@@ -186,3 +186,55 @@ def test_constant_turn_jacobian_matches_central_differences():
         e = np.zeros(5)
         e[j] = 1e-5
         np.testing.assert_allclose(J[:, j], (model.f(x + e) - model.f(x - e))[0] / 2e-5, rtol=1e-6, atol=1e-8)
+
+
+def test_rate_adaptive_noise_on_the_ekf_equals_a_hand_computation():
+    # Expected value: an independent step-by-step computation of (R1)-(R2) as documented in
+    # hinfnav/estimators/adaptive.py (κ over the last m posterior estimates, Q_ii = Q0_ii max(f_min, (ε κ_i)²)
+    # on the adapted diagonal entries) followed by the textbook Kalman update (Joseph form), plain numpy.
+    from hinfnav.estimators import RateAdaptiveEKF
+    from hinfnav.systems import LinearSystem
+
+    dt, steps, window, eps = 0.5, 30, 3, 20.0
+    Phi = np.array([[1.0, dt], [0.0, 1.0]])
+    system = LinearSystem(Phi, np.zeros((2, 1)), np.zeros((2, 1)), dt, StateSpec(labels=["p", "v"], units=["m", "m/s"]))
+    meas = LinearMeasurement(np.array([[1.0, 0.0]]), np.array([[0.3]]))
+    Q0, R, P0_, x0 = np.diag([1e-3, 1e-4]), meas.R, np.diag([1.0, 0.5]), np.array([0.0, 1.0])
+    rng = np.random.default_rng(3)
+    v = np.where(np.arange(steps) < 12, 1.0, 2.5)  # a speed change the random-walk model does not expect
+    p = np.concatenate([[0.0], np.cumsum(v[:-1] * dt)])
+    y = (p + 0.3 * rng.standard_normal(steps))[None, :, None]
+    est = RateAdaptiveEKF(system, meas, P0=P0_, Q=Q0, states=[1], memory_steps=window, epsilon=eps)
+    hist = est.estimate(y, np.zeros((1, steps, 0)), x0, diagnostics=True)
+
+    x, P, post, ref_x, ref_q = x0.copy(), P0_.copy(), [], [], []
+    H = meas.H
+    for k in range(steps):
+        if k > 0:
+            span = min(window, k - 1)
+            kappa = 0.0 if k < 2 else (post[-1][1] - post[-1 - span][1]) / (span * dt)
+            Qd = Q0.copy()
+            Qd[1, 1] = Q0[1, 1] * max(1.0, (eps * kappa) ** 2)
+            ref_q.append(Qd[1, 1])
+            x, P = Phi @ x, Phi @ P @ Phi.T + Qd
+        S = H @ P @ H.T + R
+        K = P @ H.T @ np.linalg.inv(S)
+        x = x + K @ (y[0, k] - H @ x)
+        IKH = np.eye(2) - K @ H
+        P = IKH @ P @ IKH.T + K @ R @ K.T
+        post.append(x.copy())
+        ref_x.append(x.copy())
+    # tolerance: the same arithmetic in two orders of summation
+    np.testing.assert_allclose(hist.xhat[0], np.array(ref_x), rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(hist.diagnostics["q_adapted"][0, 1:, 0], ref_q, rtol=1e-10)
+    assert max(ref_q) > 10 * Q0[1, 1]  # the speed change did raise the noise: the adaptation was exercised
+
+
+def test_rate_adaptive_names_the_states_it_needs():
+    from hinfnav.core.exceptions import InputError
+    from hinfnav.estimators import RateAdaptiveEKF
+
+    with pytest.raises(InputError, match="states"):
+        RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0)
+    with pytest.raises(InputError, match="states"):
+        RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0, states=[2, 7])

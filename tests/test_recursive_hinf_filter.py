@@ -158,3 +158,31 @@ def test_theta_zero_on_the_chaser_sits_at_the_open_loop_kalman_limit(short_scena
     assert st.pos_m_stat[0] == pytest.approx(np.sqrt(np.mean(kl.pos_m_predicted**2)), rel=1e-9)
     assert st.vel_mps_stat[0] == pytest.approx(np.sqrt(np.mean(kl.vel_mps_predicted**2)), rel=1e-9)
     assert st.vel_mps_stat[1] > st.vel_mps_stat[0]  # θ > 0 gives up accuracy in the mean-square sense
+
+
+def test_frozen_gain_equals_the_full_recursion_and_uses_the_one_freeze():
+    # the freeze is the package's one (steady.freeze_gain, rule (F2) every step): frozen and never-frozen filters
+    # agree to 1e-9 relative (identity up to the 1e-14-per-step change the freeze ignores, over 600 steps)
+    from hinfnav.estimators.steady import freeze_gain
+
+    F, H, Bq, Dv, rng = _random(2, rho=0.9)
+    sysm, meas = _model(F, H, Bq, Dv)
+    theta = 0.5 * max_admissible_theta(F, H, Bq @ Bq.T, Dv @ Dv.T)
+    y, u = rng.standard_normal((2, 600, 2)), np.zeros((2, 600, 0))
+    kw = dict(theta=theta, P0=Bq @ Bq.T + 1e-3 * np.eye(3), uses_input=False)
+    frozen = RecursiveHInfinityFilter(sysm, meas, **kw)
+    full = RecursiveHInfinityFilter(sysm, meas, steady_tol=None, **kw)
+    a = frozen.estimate(y, u, np.zeros(3))
+    b = full.estimate(y, u, np.zeros(3))
+    np.testing.assert_allclose(a.xhat, b.xhat, rtol=1e-9, atol=1e-12)
+    state = frozen.start(np.zeros(3), runs=2)
+    for k in range(600):
+        state, _ = frozen.update(state, y[:, k])
+        state = frozen.predict(state, None)
+    assert state.extra["steady"] is not None  # the recursion did converge and freeze within 600 steps
+    # (F2) by hand: ‖P − P_old‖_F ≤ tol ‖P_old‖_F, checked every step with every=1
+    P_old = np.eye(2)
+    assert freeze_gain(1e-3, 0, {"check_P": P_old}, every=1, rule="frobenius", P=P_old * (1 + 0.9e-3)) is not None
+    assert freeze_gain(1e-3, 0, {"check_P": P_old}, every=1, rule="frobenius", P=P_old * (1 + 1.1e-3)) is None
+    with pytest.raises(hn.InputError, match="rule"):
+        freeze_gain(1e-3, 0, {}, every=1, rule="max", P=P_old)

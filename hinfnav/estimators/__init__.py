@@ -15,10 +15,10 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .augmented import AugmentedEKF, AugmentedInputAdaptiveKF, AugmentedInputHuberSTKF, AugmentedInputKF, AugmentedInputSTKF
     from .extended_state import ExtendedStateKalmanFilter
     from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
-    from .correction import KalmanCorrection, drop_missing, joseph_update, kalman_gain
-    from .huber_filter import HuberCorrection, HuberFilter
+    from .correction import KalmanCorrection, drop_missing, joseph_covariance, joseph_update, kalman_gain
+    from .huber_filter import HuberCorrection, HuberFilter, HuberStrongTrackingEKF
     from .recursive_hinf import RecursiveHInfinityFilter
-    from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, StrongTrackingEKF
+    from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
     from .lti import LTIFilter
     from .sigma_point import SigmaPointFilter
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
@@ -39,6 +39,7 @@ __all__ = [
     "HuberCorrection",
     "KalmanCorrection",
     "joseph_update",
+    "joseph_covariance",
     "kalman_gain",
     "drop_missing",
     "AugmentedInputHuberSTKF",
@@ -49,6 +50,8 @@ __all__ = [
     "SigmaPointFilter",
     "StrongTracking",
     "StrongTrackingEKF",
+    "HuberStrongTrackingEKF",
+    "RateAdaptiveEKF",
     "RateAdaptive",
     "AugmentedEKF",
     "AugmentedInputKF",

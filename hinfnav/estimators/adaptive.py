@@ -5,7 +5,8 @@ on either Kalman core: :class:`~hinfnav.estimators.ExtendedKalmanFilter` (a
 linear system or any dynamics model, e.g. a constant-turn target) and
 :class:`~hinfnav.estimators.augmented.AugmentedEKF` (an EKF whose last error
 coordinates are random-walk augmented states). Rate-adapted noise (hook
-``process_noise``) needs augmented states, so it acts on the augmented core.
+``process_noise``) acts on both as well: on the augmented states of the
+augmented core, or on the states named by ``states`` of an EKF.
 
 **Strong tracking** (suboptimal multiple fading factors; Zhou, Xi & Zhang,
 Acta Automatica Sinica 17(6), 1991, rebuilt there from; paper 002 §2.3):
@@ -245,7 +246,15 @@ class StrongTracking:
 
 
 class RateAdaptive:
-    """Mixin: process noise of the augmented states from their estimated rate (R1)–(R2).
+    """Mixin: process noise of the rate-adapted states from their estimated rate (R1)–(R2).
+
+    On :class:`~hinfnav.estimators.augmented.AugmentedEKF` the adapted states
+    are its augmented states and the host's ``Q`` is their density Q(t₀):
+    ``Q_d = Q_base + Δt Γ diag(q) Γᵀ``. On
+    :class:`~hinfnav.estimators.ExtendedKalmanFilter` (a linear system or any
+    dynamics model) ``states`` names them and the host's per-step ``Q`` is
+    Q(t₀): ``Q_d`` is ``Q`` with its diagonal entries ``(i, i)``, i in
+    ``states``, replaced by the adapted ``q_i`` (R2) (the other entries kept).
 
     Parameters
     ----------
@@ -253,19 +262,23 @@ class RateAdaptive:
         m, the number of steps over which the rate is estimated (≥ 1). Called
         ``window`` before issue 23 (still accepted, with a DeprecationWarning).
     epsilon : float or array_like, shape (runs,)
-        Compression factor ε, s per unit of the augmented state (> 0); one
+        Compression factor ε, s per unit of the adapted state (> 0); one
         value per run batches an ε sweep.
     floor : float
         f_min of (R2), ≥ 0 (1: Q(t₀) is the least noise).
+    states : sequence of int, optional
+        Indices of the adapted states in the estimated state (required on an
+        EKF; not allowed on a host with augmented states, which adapts those).
 
-    The host's ``Q`` is Q(t₀). Diagnostics: ``q_adapted`` (runs, n_aug), the
-    density used for the prior of this step, and ``input_rate`` κ (runs, n_aug).
+    Diagnostics: ``q_adapted`` (runs, n_adapted), the noise used for the
+    prior of this step, and ``input_rate`` κ (runs, n_adapted).
     """
 
     data_dependent_covariance = True
+    defers_prior = True
 
     def __init__(self, *args: Any, memory_steps: int = 60, epsilon: float = 1.0, floor: float = 1.0,
-                 window: int | None = None, **kwargs: Any) -> None:
+                 states: Any = None, window: int | None = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         if window is not None:
             warnings.warn("window is deprecated, use memory_steps (m, steps)", DeprecationWarning, stacklevel=2)
@@ -273,32 +286,59 @@ class RateAdaptive:
         self.memory_steps = as_int_at_least("memory_steps", memory_steps, 1)
         self.epsilon = per_run_parameter("epsilon", epsilon, as_positive)
         self.floor = as_nonnegative("floor", floor)
-        self._Q0_diag = np.diag(self.Q).copy()
+        if hasattr(self, "n_aug"):  # augmented host: its augmented states, Q their density
+            if states is not None:
+                raise InputError("states must not be given on a filter with augmented states (they are adapted)")
+            self._rate_states = None
+            self._n_rate = self.n_aug
+        else:
+            if states is None:
+                raise InputError("states (indices of the states whose noise is rate-adapted) must be given on "
+                                 "this filter")
+            idx = np.asarray(states)
+            if (idx.ndim != 1 or idx.size == 0 or not np.issubdtype(idx.dtype, np.integer)
+                    or np.any(idx < 0) or np.any(idx >= self.n_state) or np.unique(idx).size != idx.size):
+                raise InputError(f"states must be distinct indices in [0, {self.n_state}); got {states!r}")
+            self._rate_states = idx
+            self._n_rate = idx.size
+        self._Q0_diag = np.diag(self.Q).copy() if self._rate_states is None else np.diag(self.Q)[self._rate_states]
+
+    transient_keys = ("prior", "PhiPPhiT", "Qd", "q_used", "kappa_used")
+
+    def rate_states(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The estimate of the adapted states, (runs, n_adapted)."""
+        return self.augmented(x) if self._rate_states is None else x[:, self._rate_states]
 
     def process_noise(self, state: FilterState) -> tuple[NDArray[np.float64], dict[str, Any]]:
         extra = state.extra
         kappa = input_rate(extra["rate_history"], extra["rate_count"], self.memory_steps, self.dt)
         q = rate_adapted_density(self._Q0_diag, kappa, self.epsilon, self.floor)
-        Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
+        if self._rate_states is None:
+            Qd = self.base_noise + self.dt * ((self.E * q[:, None, :]) @ self.E.T)  # Δt Γ diag(q) Γᵀ per run
+        else:
+            Qd = np.broadcast_to(self.Q, (q.shape[0],) + self.Q.shape).copy()
+            Qd[:, self._rate_states, self._rate_states] = q
         return Qd, {"q_used": q, "kappa_used": kappa}
 
     def _start(self, xhat0, P0, runs):
         state = super()._start(xhat0, P0, runs)
-        history = np.zeros((self.memory_steps + 1, runs, self.n_aug))
+        history = np.zeros((self.memory_steps + 1, runs, self._n_rate))
         state.extra.update(rate_history=history, rate_count=0)
         return state
 
     def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
+        out = super().after_update(state, x_post)
         history = state.extra["rate_history"].copy()
         count = state.extra["rate_count"]
-        history[count % (self.memory_steps + 1)] = self.augmented(x_post)
-        return {"rate_history": history, "rate_count": count + 1}
+        history[count % (self.memory_steps + 1)] = self.rate_states(x_post)
+        out.update(rate_history=history, rate_count=count + 1)
+        return out
 
     def step_diagnostics(self, state: FilterState) -> dict[str, Any]:
         out = super().step_diagnostics(state)
         runs = state.x.shape[0]
         q = state.extra.get("q_used")
         kappa = state.extra.get("kappa_used")
-        out["q_adapted"] = np.broadcast_to(self._Q0_diag, (runs, self.n_aug)) if q is None else q
-        out["input_rate"] = np.zeros((runs, self.n_aug)) if kappa is None else kappa
+        out["q_adapted"] = np.broadcast_to(self._Q0_diag, (runs, self._n_rate)) if q is None else q
+        out["input_rate"] = np.zeros((runs, self._n_rate)) if kappa is None else kappa
         return out

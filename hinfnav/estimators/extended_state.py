@@ -130,9 +130,31 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         self.steady_tol = check_steady_tol(steady_tol)
         self._q_sqrt = np.sqrt(self.q)
 
-    def predict_covariance(self, P: NDArray[np.float64], state: FilterState) -> NDArray[np.float64]:
-        """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` (Algorithm 1)."""
+    # -- the core's prediction hooks ------------------------------------------------------
+
+    def predict_mean(self, x: NDArray[np.float64], u: NDArray[np.float64] | None, t: float = 0.0) -> NDArray[np.float64]:
+        """``A_d X̂ + B_d u + B_e Ĝ_k`` (Algorithm 1), Ĝ_k of (9) from the nominal model at k = t / Δt (0 without one)."""
+        x = super().predict_mean(x, u, t)
+        if self.nominal is not None:
+            x = x + predicted_increment(self.nominal, int(round(t / self.dt)), self._q_sqrt) @ self.B_e.T
+        return x
+
+    def predict_covariance(self, P: NDArray[np.float64], state: FilterState, F: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` (Algorithm 1), or the frozen prior once the recursion has converged
+        (``state`` None: the formula)."""
+        steady = None if state is None else state.extra.get("steady")
+        if steady is not None:
+            return steady["P_prior"]
         return (1.0 + self.theta) * (self.F @ P @ self.F.T) + self.Q
+
+    def after_predict(self, state: FilterState, P: NDArray[np.float64]) -> dict[str, Any]:
+        """The steady record (:func:`~hinfnav.estimators.steady.freeze_gain` on P⁻) and its check value."""
+        steady = state.extra.get("steady")
+        if steady is not None:
+            return {"steady": steady}
+        record = {"check_P_prior": state.extra.get("check_P_prior")}
+        record["steady"] = freeze_gain(self.steady_tol, state.k, record, P_prior=P)
+        return record
 
     def gain(self, P_prior: NDArray[np.float64], H: NDArray[np.float64] | None = None, R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kalman gain and Joseph-form posterior for a prior covariance (shared or per run).
@@ -178,17 +200,3 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         if self.output == "filtered":
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)
-
-    def _predict(self, state, u):
-        x = self.predict_mean(state.x, np.asarray(u, dtype=float))
-        if self.nominal is not None:
-            x = x + predicted_increment(self.nominal, state.k, self._q_sqrt) @ self.B_e.T
-        steady = state.extra.get("steady")
-        extra = {key: val for key, val in state.extra.items() if key != "prior"}
-        if steady is not None:
-            P = steady["P_prior"]
-        else:
-            P = self.predict_covariance(state.P, state)
-            steady = freeze_gain(self.steady_tol, state.k, extra, P_prior=P)
-        extra["steady"] = steady
-        return FilterState(x=x, P=P, k=state.k + 1, extra=extra)

@@ -37,14 +37,14 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive
 from .huber import huber_correct, whitening
-from .kalman import ExtendedKalmanFilter
+from .kalman import ExtendedKalmanFilter, StrongTrackingEKF
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["HuberCorrection", "HuberFilter"]
+__all__ = ["HuberCorrection", "HuberFilter", "HuberStrongTrackingEKF"]
 
 
 class HuberCorrection:
@@ -130,3 +130,15 @@ class HuberFilter(HuberCorrection, ExtendedKalmanFilter):
         return cls(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R, gamma=gamma, tol=tol,
                    max_iter=max_iter, uses_input=ekf.uses_input, output=ekf.output,
                    name=name if name is not None else "hbf", missing=ekf.missing)
+
+
+class HuberStrongTrackingEKF(HuberCorrection, StrongTrackingEKF):
+    """Huber × strong tracking on the EKF core: fading factors (S1)–(S4) for the prior, Huber's M-estimation
+    for the correction.
+
+    Parameters of :class:`~hinfnav.estimators.StrongTrackingEKF` (``rho``,
+    ``beta``, ``a``; R constant) and of :class:`HuberFilter` (``gamma``,
+    ``tol``, ``max_iter``). Diagnostics of both (``fading``, ``weights`` …).
+    """
+
+    name = "huber_stekf"

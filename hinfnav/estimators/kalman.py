@@ -14,8 +14,14 @@ variants override small hooks:
   :class:`~hinfnav.estimators.AugmentedEKF`: a filter whose class sets
   ``defers_prior`` keeps ``F P Fᵀ`` and ``Q`` from ``predict`` and completes
   P(k+1|k) when y(k+1) arrives, so the mixins of
-  :mod:`hinfnav.estimators.adaptive` (strong tracking) work on both cores,
-  on a linear system or any dynamics model;
+  :mod:`hinfnav.estimators.adaptive` (strong tracking, rate-adapted noise)
+  work on both cores, on a linear system or any dynamics model
+  (:class:`StrongTrackingEKF`, :class:`RateAdaptiveEKF`);
+* :meth:`~ExtendedKalmanFilter.predict_mean` — ``Φ x̂ + Γ u`` or ``f(x̂, u, t)``
+  (Algorithm 1 adds its predicted disturbance increment, the GRACE filter
+  propagates the mean through a two-body model), and
+  :meth:`~KalmanCore.after_predict` — items kept after a prediction (a
+  steady-gain freeze's record, :mod:`hinfnav.estimators.steady`);
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
 * :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
@@ -41,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
-from .adaptive import StrongTracking
+from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 
@@ -50,7 +56,7 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "StrongTrackingEKF"]
+__all__ = ["OUTPUTS", "ExtendedKalmanFilter", "KalmanCore", "RateAdaptiveEKF", "StrongTrackingEKF"]
 
 #: What ``update`` reports at t_k: x̂(k|k) or x̂(k|k−1).
 OUTPUTS = ("filtered", "predicted")
@@ -70,7 +76,7 @@ class KalmanCore(KalmanCorrection, Estimator):
     in error coordinates), ``report``/``report_covariance`` (what a step
     returns), ``correct``/``correct_error`` (the Joseph update (J1)-(J2), or
     Huber's), ``measurement_covariance`` (R_k), ``complete_prior`` (strong
-    tracking), ``after_update`` and the diagnostics hooks.
+    tracking), ``after_update``/``after_predict`` and the diagnostics hooks.
     """
 
     #: True when the covariance depends on the data (a mixin's Huber weights, fading factors …)
@@ -137,6 +143,10 @@ class KalmanCore(KalmanCorrection, Estimator):
 
     def after_update(self, state: FilterState, x_post: NDArray[np.float64]) -> dict[str, Any]:
         """Extra items to keep after an update (none here)."""
+        return {}
+
+    def after_predict(self, state: FilterState, P: NDArray[np.float64]) -> dict[str, Any]:
+        """Extra items to keep after a prediction to P(k+1|k) (none here; a gain freeze keeps its record)."""
         return {}
 
     def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -322,13 +332,11 @@ class ExtendedKalmanFilter(KalmanCore):
         if self.uses_input and u is None:
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         F = None
+        t = state.k * self.dt
         if self.nonlinear_dynamics:  # the Jacobian at the posterior x̂(k|k), before the mean moves on
-            t = state.k * self.dt
             F = np.asarray(self.system.jacobian(state.x, u if self.uses_input else None, t), dtype=float)
-            x = self.predict_mean(state.x, u, t)
-        else:
-            x = self.predict_mean(state.x, u)
-        extra = {key: val for key, val in state.extra.items() if key not in _TRANSIENT}
+        x = self.predict_mean(state.x, u, t)
+        extra = {key: val for key, val in state.extra.items() if key not in self.transient_keys}
         if self.defers_prior:  # F P Fᵀ and Q_d kept for complete_prior at the next reading
             PhiPPhiT = self.propagated_covariance(state.P, F)
             Qd, e_noise = self.process_noise(state)
@@ -338,6 +346,7 @@ class ExtendedKalmanFilter(KalmanCore):
             P = self.predict_covariance(state.P, state, F=F)
         else:
             P = self.predict_covariance(state.P, state)
+        extra.update(self.after_predict(state, P))
         return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
 
 
@@ -352,3 +361,16 @@ class StrongTrackingEKF(StrongTracking, ExtendedKalmanFilter):
     """
 
     name = "stekf"
+
+
+class RateAdaptiveEKF(RateAdaptive, ExtendedKalmanFilter):
+    """Rate-adapted process noise on :class:`ExtendedKalmanFilter` (R1)–(R2).
+
+    On a linear system or any dynamics model; parameters of
+    :class:`ExtendedKalmanFilter` and ``states``, ``window``, ``epsilon``,
+    ``floor`` of :class:`~hinfnav.estimators.adaptive.RateAdaptive` (the
+    diagonal entries of Q at ``states`` follow their states' estimated rate).
+    Diagnostics ``q_adapted`` and ``input_rate`` (runs, len(states)).
+    """
+
+    name = "aekf_rate"

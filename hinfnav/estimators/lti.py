@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -11,8 +10,7 @@ from numpy.typing import ArrayLike
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
-from .base import EstimateHistory, Estimator, FilterState, StepOutput, check_estimator_inputs, history_keys
-from .compiled import select_backend
+from .base import Estimator, FilterState, StepOutput
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -62,6 +60,8 @@ class LTIFilter(Estimator):
     A predictor: the estimate at t_k uses y(0) … y(k−1), as (12) prescribes
     (``update`` stores y_k and reports ``C_F x_f(k)``). The initial filter
     state is ``x_f(0) = C_F⁻¹ x̂(0)`` so that the first estimate is x̂(0).
+    The gains are fixed: the batch ``estimate`` is the base class's one loop
+    over these hooks (no separate batch recursion).
     """
 
     def __init__(self, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, system: LinearSystem | DynamicsModel, measurement: MeasurementModel,
@@ -121,23 +121,3 @@ class LTIFilter(Estimator):
             raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
         x = state.x @ self._A_eff.T + self._drive(state.extra["y"], u)
         return FilterState(x=x, k=state.k + 1)
-
-    def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
-                 keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False,
-                 backend: str = "numpy") -> EstimateHistory:
-        """Vectorized over runs and fast: same numbers as the step loop (bitwise); no compiled kernel."""
-        select_backend(self, backend)  # "numba" is refused (no kernel); "auto" is this NumPy path
-        history_keys(keep_covariance, diagnostics)  # checked; the filter has neither a covariance nor diagnostics
-        y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
-                                             self.n_input if self.uses_input else None, self.missing)
-        if np.isnan(y).any():  # missing readings are filled from the estimate, step by step
-            return super().estimate(y, u, xhat0, P0, keep_covariance=keep_covariance, diagnostics=diagnostics)
-        runs, n1, _ = y.shape
-        n = self.A_F.shape[0]
-        drive = self._drive(y, u)
-        xf = np.empty((runs, n1, n))
-        xf[:, 0] = self._CF_inv @ xhat0
-        At = self._A_eff.T
-        for k in range(n1 - 1):
-            xf[:, k + 1] = xf[:, k] @ At + drive[:, k]
-        return EstimateHistory(xhat=xf @ self.C_F.T, state=self.system.state)

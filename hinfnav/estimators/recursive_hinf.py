@@ -20,8 +20,10 @@ Cᵀ(P⁻¹ + G)C``: the existence condition is ``N > 0`` (checked by a Cholesky
 factorization at every step; its smallest eigenvalue is reported as the
 ``existence_margin`` diagnostic), ``K = C N⁻¹ Cᵀ HᵀR⁻¹`` and
 ``P⁺ = F C N⁻¹ Cᵀ Fᵀ + Q``. P and K do not depend on the data: one recursion
-serves every run, and once ``‖P_{k+1} − P_k‖ ≤ 10⁻¹⁴ ‖P_k‖`` (Frobenius) the
-steady gain is kept (:func:`hinfnav.analysis.steady_state_hinf` gives that
+serves every run, and once ``‖P_{k+1} − P_k‖ ≤ 10⁻¹⁴ ‖P_k‖`` (Frobenius; the
+package's one freeze, :func:`~hinfnav.estimators.steady.freeze_gain` with
+rule (F2) checked every step, tolerance ``steady_tol``) the steady gain is
+kept (:func:`hinfnav.analysis.steady_state_hinf` gives that
 steady state directly).
 
 filterpy's ``HInfinityFilter`` (2.0) is not this filter: it propagates P only
@@ -45,18 +47,20 @@ from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
 from .base import Estimator, FilterState, StepOutput
+from .steady import freeze_gain
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION"]
+__all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION", "STEADY_TOL"]
 
 #: What the filter does when the existence condition fails.
 ON_VIOLATION = ("raise", "flag")
 
-_FREEZE = 1e-14  # relative change of P below which the steady gain is kept
+#: Default ``steady_tol``: relative change of P per step (Frobenius) below which the steady gain is kept.
+STEADY_TOL = 1e-14
 
 
 class RecursiveHInfinityFilter(Estimator):
@@ -103,7 +107,8 @@ class RecursiveHInfinityFilter(Estimator):
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, theta: float, P0: ArrayLike,
                  Q: ArrayLike | None = None, R: ArrayLike | None = None, L: ArrayLike | None = None, S: ArrayLike | None = None, uses_input: bool = True,
-                 on_violation: str = "raise", name: str | None = None, missing: str = "refuse") -> None:
+                 on_violation: str = "raise", steady_tol: float | None = STEADY_TOL, name: str | None = None,
+                 missing: str = "refuse") -> None:
         super().__init__(system, measurement, name=name, missing=missing)
         if not getattr(measurement, "linear", False) or measurement.H is None:
             raise InputError(f"measurement must be linear (y = H x + D v); got {type(measurement).__name__}")
@@ -122,6 +127,7 @@ class RecursiveHInfinityFilter(Estimator):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
         self.uses_input = bool(uses_input)
         self.on_violation = as_choice("on_violation", on_violation, ON_VIOLATION)
+        self.steady_tol = None if steady_tol is None else as_nonnegative("steady_tol", steady_tol)
         self._HtRi = np.linalg.solve(self.R, self.H).T  # Hᵀ R⁻¹
         W = self._HtRi @ self.H
         self.Sbar = self.L.T @ self.S @ self.L
@@ -187,7 +193,7 @@ class RecursiveHInfinityFilter(Estimator):
             K, P_fixed, margin, ok = steady
             return K, P_fixed, margin, ok, steady
         K, P_next, margin, ok = self.riccati_step(P, k)
-        if ok and np.linalg.norm(P_next - P) <= _FREEZE * np.linalg.norm(P):
+        if ok and freeze_gain(self.steady_tol, k, {"check_P": P}, every=1, rule="frobenius", P=P_next) is not None:
             steady = (K, P, margin, ok)
             P_next = P
         return K, P_next, margin, ok, steady

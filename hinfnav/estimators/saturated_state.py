@@ -21,8 +21,8 @@ from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement, Saturated
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput
-from .correction import drop_missing
-from .extended_state import ExtendedStateKalmanFilter, check_steady_tol, predicted_increment
+from .correction import drop_missing, joseph_covariance, kalman_gain
+from .extended_state import ExtendedStateKalmanFilter, check_steady_tol
 from .steady import freeze_gain
 
 __all__ = ["SaturatedExtendedStateFilter", "FusedExtendedStateFilter", "MODES", "FUSED_COVARIANCES"]
@@ -136,8 +136,9 @@ class SaturatedExtendedStateFilter(Estimator):
         meas = Saturated(LinearMeasurement(Cm, np.diag(np.sqrt(self.Reff)), labels=measurement_labels,
                                            units=measurement_units), self.lower, self.upper)
         super().__init__(system, meas, name=name, missing=missing)
-        self._I3 = np.eye(3)
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
+        self._Crow = self.C[:, None, :]  # (axes, 1, 3): H of each axis
+        self._Rcol = self.Reff[:, None, None]  # (axes, 1, 1): R of each axis
 
     # -- array kernels (runs, n_axes, 3) -------------------------------------------------
 
@@ -193,9 +194,9 @@ class SaturatedExtendedStateFilter(Estimator):
             K, P_post = cache
             innov = y - yhat
             return X + K * innov[..., None], P_post, innov, sat, K
-        K = (P @ self._Ccol)[..., 0]  # P Cᵀ, (runs, axes, 3)
-        Sy = (K[..., None, :] @ self._Ccol)[..., 0, 0] + self.Reff
-        K = K / Sy[..., None]
+        Kc, P_post, Sy = kalman_gain(P, self._Crow, self._Rcol, symmetrize=False)  # (J1)-(J2) per axis
+        K, Sy = Kc[..., 0], Sy[..., 0, 0]
+        modified = False
         y_eff = y
         extra_var = None
         if any_sat:
@@ -213,13 +214,13 @@ class SaturatedExtendedStateFilter(Estimator):
                 extra_var[trunc] = v
             if skip_sat.any():  # keep the prediction on a skipped reading
                 K = np.where(skip_sat[..., None], 0.0, K)
+                modified = True
         innov = y_eff - yhat
         X_post = X + K * innov[..., None]
-        IKC = self._I3 - K[..., :, None] * self.C[:, None, :]
-        KKt = K[..., :, None] * K[..., None, :]
-        P_post = IKC @ P @ np.swapaxes(IKC, -1, -2) + self.Reff[:, None, None] * KKt
+        if modified:  # (J2) with the gain of the readings used
+            P_post = joseph_covariance(P, K[..., :, None], self._Crow, self._Rcol, symmetrize=False)
         if extra_var is not None:
-            P_post = P_post + extra_var[..., None, None] * KKt
+            P_post = P_post + extra_var[..., None, None] * (K[..., :, None] * K[..., None, :])
         return X_post, P_post, innov, sat, K
 
     def kernel_predict(self, X: NDArray[np.float64], P: NDArray[np.float64] | None, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
@@ -431,9 +432,7 @@ class FusedExtendedStateFilter(Estimator):
     def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
         a1 = self.alg1
-        x1 = a1.predict_mean(state.x, u)
-        if a1.nominal is not None:
-            x1 = x1 + predicted_increment(a1.nominal, state.k, a1._q_sqrt) @ a1.B_e.T
+        x1 = a1.predict_mean(state.x, u, state.k * a1.dt)  # Algorithm 1's hook (with the nominal increment (9))
         u2 = u[:, self.uidx]
         steady = state.extra["steady"]
         extra = dict(state.extra, u_feed=np.zeros_like(u2))

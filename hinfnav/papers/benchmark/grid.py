@@ -100,6 +100,8 @@ _WHY_NOT = {
            "truth_model, xhat0 and P0); this scenario offers neither",
     "ukf": "the sigma-point filter is built as the unscented version of a registered Kalman filter of the scenario "
            "(Sun 2011's ekf_known_input, Shi 2018's EKF); this scenario has none registered",
+    "kalman_variant": "strong tracking (and Huber x strong tracking) is built on a registered Kalman filter of the "
+                      "scenario (Sun 2011's ekf_known_input, Shi 2018's EKF); this scenario has none registered",
 }
 
 
@@ -112,6 +114,8 @@ def _family(name):
         return "yang2020"
     if name in ("hbf", "ekf_converted", "ukf"):
         return name
+    if name in ("stekf", "huber_stekf"):
+        return "kalman_variant"
     return "sun2011"
 
 

@@ -34,7 +34,6 @@ from ...core.exceptions import HinfnavError, LooseBoundWarning, SolverAccuracyWa
 from ...design import SampleSet, SolverOptions, synthesize, synthesize_mixed
 from ...estimators import (
     ExtendedKalmanFilter,
-    FilterState,
     HuberFilter,
     RecursiveHInfinityFilter,
 )
@@ -88,17 +87,15 @@ class NonlinearPredictionEKF(ExtendedKalmanFilter):
         self.chief = chief
         self._f = pair(MODELS[model])
 
-    def _predict(self, state, u):
-        """The step contract's prediction hook: the mean through the nonlinear pair model, P through Φ."""
-        k = state.k
+    def predict_mean(self, x, u, t=0.0):
+        """The core's mean-prediction hook: x̂(k|k) at t = k Δt through the nonlinear pair model (P through Φ)."""
+        k = int(round(t / self.dt))
         r_c, v_c = self.chief[0][k], self.chief[1][k]
-        r_d, v_d = hill_to_inertial(r_c, v_c, state.x)
-        runs = state.x.shape[0]
+        r_d, v_d = hill_to_inertial(r_c, v_c, x)
+        runs = x.shape[0]
         X = np.concatenate([np.broadcast_to(r_c, (runs, 3)), np.broadcast_to(v_c, (runs, 3)), r_d, v_d], axis=-1)
         X = rk4(self._f, X, k * DT_S, DT_S, 1)  # one 10 s RK4 step: within 3e-8 m of 5 s steps
-        x = inertial_to_hill(X[:, :3], X[:, 3:6], X[:, 6:9], X[:, 9:12])
-        P = self.predict_covariance(state.P, state)
-        return FilterState(x=x, P=P, k=k + 1, extra={key: v for key, v in state.extra.items() if key != "prior"})
+        return inertial_to_hill(X[:, :3], X[:, 3:6], X[:, 6:9], X[:, 9:12])
 
 
 def model_mismatch_moment(data, model):

@@ -35,6 +35,7 @@ import numpy as np
 import scipy.optimize
 
 from ...core.exceptions import HinfnavError, InputError
+from ...estimators.correction import kalman_gain
 from ...metrics.errors import window_mask
 from .constants import CALIBRATION_TARGET
 from .scenario import Scenario
@@ -91,10 +92,7 @@ def riccati_accuracy(scenario, *, maneuver=False, window=None):
     P = np.array(scenario.P0)
     std = np.empty((scenario.n_steps + 1, 6))
     for k in range(scenario.n_steps + 1):
-        S = H @ P @ H.T + R[k]
-        K = P @ H.T @ np.linalg.inv(S)
-        I_KH = np.eye(6) - K @ H
-        P = I_KH @ P @ I_KH.T + K @ R[k] @ K.T
+        _, P, _ = kalman_gain(P, H, R[k], symmetrize=False)  # the package's one Joseph update (J1)-(J2)
         std[k] = np.sqrt(np.diag(P))
         P = Phi @ P @ Phi.T + Q
     axes = np.sqrt(np.mean(std[mask] ** 2, axis=0))

@@ -28,14 +28,14 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_positive
-from ...estimators.huber_filter import HuberFilter
-from ...estimators.kalman import ExtendedKalmanFilter
+from ...estimators.huber_filter import HuberFilter, HuberStrongTrackingEKF
+from ...estimators.kalman import ExtendedKalmanFilter, StrongTrackingEKF
 from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
 
-__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "build_ukf", "HBF_BASES"]
+__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "build_ukf", "build_stekf", "build_huber_stekf", "HBF_BASES"]
 
 #: How the filters use the readings: converted to position (the paper's indirect measurement) or directly.
 MEASUREMENTS = ("converted", "direct")
@@ -179,6 +179,45 @@ def build_ukf(scenario, *, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0, bas
     return SigmaPointFilter.from_ekf(build_estimator(base, scenario, **options), name="ukf", **points)
 
 
+def _kalman_base(scenario, base, options, what):
+    """The Kalman filter a variant is built on: Shi 2018's EKF on the range/angle readings themselves (a constant R,
+    which strong tracking needs), or the scenario's registered Kalman filter (``base``, default :func:`_base_name`)."""
+    if isinstance(scenario, Scenario):
+        if base is not None:
+            raise InputError("base applies only to scenarios of other papers")
+        options.setdefault("measurement", "direct")
+        return EKF(scenario, **options)
+    base = _base_name(scenario) if base is None else base
+    if base is None:
+        raise InputError(f"{what} needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}); "
+                         f"{type(scenario).__name__} has none")
+    return build_estimator(base, scenario, **options)
+
+
+def build_stekf(scenario, *, rho=0.95, beta=1.0, a=None, base=None, **options):
+    """The registry's ``stekf``: strong tracking (paper 002, (S1)-(S4)) on a scenario's Kalman filter.
+
+    On Shi & Wang (2018)'s scenario the EKF of the range/angle readings
+    (``measurement="direct"``: strong tracking needs a constant R); elsewhere
+    the scenario's registered Kalman filter (as for ``ukf``), same model, Q,
+    R, P₀ and input use. ``rho``, ``beta``, ``a``: of
+    :class:`~hinfnav.estimators.StrongTrackingEKF`; ``options`` go to the Kalman filter's builder.
+    """
+    ekf = _kalman_base(scenario, base, options, "stekf")
+    return StrongTrackingEKF(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R, uses_input=ekf.uses_input,
+                             output=ekf.output, name="stekf", rho=rho, beta=beta, a=a)
+
+
+def build_huber_stekf(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, rho=0.95, beta=1.0, a=None, base=None,
+                      **options):
+    """The registry's ``huber_stekf``: :func:`build_stekf` with Huber's M-estimation as the correction
+    (:class:`~hinfnav.estimators.HuberStrongTrackingEKF`; ``gamma``, ``tol``, ``max_iter`` as for ``hbf``)."""
+    ekf = _kalman_base(scenario, base, options, "huber_stekf")
+    return HuberStrongTrackingEKF(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R,
+                                  uses_input=ekf.uses_input, output=ekf.output, name="huber_stekf", rho=rho,
+                                  beta=beta, a=a, gamma=gamma, tol=tol, max_iter=max_iter)
+
+
 def _build_ekf(scenario, **options):
     return EKF(scenario, **options)
 
@@ -192,3 +231,9 @@ register_estimator("ukf", build_ukf, fits=_fits_ukf,
 register_estimator("ekf_converted", _build_ekf, fits=lambda scenario: isinstance(scenario, Scenario),
                    description="EKF on the converted (indirect) position measurement, R_k = J R J^T "
                                "(Shi & Wang 2018's comparison)")
+register_estimator("stekf", build_stekf, fits=_fits_ukf,
+                   description="strong-tracking EKF (paper 002's fading factors) on the scenario's Kalman filter "
+                               "(Shi 2018: the range/angle EKF; elsewhere its registered Kalman filter)")
+register_estimator("huber_stekf", build_huber_stekf, fits=_fits_ukf,
+                   description="Huber x strong tracking: the strong-tracking EKF with Huber's M-estimation as its "
+                               "correction")
