@@ -244,7 +244,7 @@ def design_report(delta_bar: float, solver: str | None = None, scenario: Scenari
     delta_bar : float
         Uncertainty bound δ̄ ≥ 0.
     solver : str, optional
-        ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: Clarabel, CVXOPT fallback).
+        ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: CVXOPT, Clarabel fallback).
     scenario : Scenario, optional
     form : {"general", "observer"}, optional
         Filter structure (see :func:`synthesize`).
