@@ -25,6 +25,7 @@ from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
 from ...sim.nonlinear import simulate_nonlinear_truth
 from ...sim.truth import Truth
+from .chaser import run_passes
 from .constants import (
     DEFAULT_AA,
     DEFAULT_ST,
@@ -47,7 +48,6 @@ __all__ = [
     "first_runs",
     "run_batched",
     "run_filter",
-    "run_passes",
     "sweep_study",
 ]
 
@@ -251,43 +251,14 @@ def run_batched(builder, key, values, truth, scenario, *, labels=None, keep=Fals
     return out
 
 
-def run_passes(builder, passes, scenario, *, diagnostics=()):
-    """Several passes of one filter, each ``(truth, params)``, as one batch over all their runs.
-
-    A pass costs mostly its per-step Python overhead, nearly the same for 4 runs as for 56 (measured,
-    issue 21: ASTEKF 2.5 s CPU for 4 runs, 5.6 s for 56), so the main runs and a sweep of the same filter
-    go through one pass. Every pass gives the same parameter names (scalars); the builder gets one value
-    per run. Runs are independent in the batched filters, so each pass's numbers are those of its own pass.
-
-    Returns
-    -------
-    errors : list of ndarray
-        Per pass, the error history (runs, n_samples, 9) of its truth.
-    diagnostics : dict
-        The batch's diagnostics (run 0 is the first pass's run 0).
-    """
-    sizes = [truth.x.shape[0] for truth, _ in passes]
-    keys = tuple(passes[0][1])
-    per_run = {k: np.concatenate([np.full(n, params[k], dtype=float) for (_, params), n in zip(passes, sizes)])
-               for k in keys}
-    est = builder(scenario, **per_run)
-    y = np.concatenate([truth.y for truth, _ in passes])
-    u = np.concatenate([truth.u for truth, _ in passes])
-    hist = est.estimate(y, u, scenario.xhat0, keep_covariance=False, diagnostics=tuple(diagnostics))
-    errors, start = [], 0
-    for (truth, _), n in zip(passes, sizes):
-        errors.append(truth.state.error(truth.x, hist.xhat[start:start + n]))
-        start += n
-    return errors, hist.diagnostics
-
-
 def _main_and_sweeps(builder, key, diag, truth, main_params, sweeps, scenario, eps0):
     """The main runs of one filter (histories kept) and its sweeps, one pass; returns (main stats, [sweep stats]).
 
     ``sweeps``: ``(truth, run parameters, recorded parameters, label, keep histories)`` per sweep value.
     """
     passes = [(truth, main_params)] + [(small, params) for small, params, _, _, _ in sweeps]
-    errors, diagnostics = run_passes(builder, passes, scenario, diagnostics=diag)
+    errors, hist = run_passes(builder, passes, scenario, diagnostics=diag)
+    diagnostics = hist.diagnostics
     main = filter_stats(key, errors[0], truth.t, scenario, params=dict(est_params(key, eps0)), keep=True,
                         diagnostics=diagnostics)
     out = [filter_stats(label, err, small.t, scenario, params=record, keep=keep)
