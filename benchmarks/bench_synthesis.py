@@ -8,7 +8,10 @@ forms are run: ``general`` (LMI (20) as in the paper) and ``observer``
 (``C_F = −L``, ``A_F = A + B_F C`` imposed); a last table compares them
 (γ_observer / γ* and the residual of :func:`hinfnav.analysis.observer_form`).
 
-Run: ``python benchmarks/bench_synthesis.py [--repeat N] [--form general|observer|both]`` (not a test).
+First it times one design at δ̄ = 0.05 with the default solver chain (certificate included), wall and CPU,
+against the budget of issue 21 (0.3 s on an idle core).
+
+Run: ``python benchmarks/bench_synthesis.py [--repeat N] [--form general|observer|both] [--budget-only]`` (not a test).
 """
 
 import argparse
@@ -17,11 +20,32 @@ import time
 import numpy as np
 
 from hinfnav.analysis import observer_form
-from hinfnav.papers.sun2011 import DEFAULT_DELTA_BARS, Scenario, gamma_sweep
+from hinfnav.papers.sun2011 import DEFAULT_DELTA_BARS, Scenario, design_for_scenario, gamma_sweep
+
+#: Issue 21: one design at δ̄ = 0.05 (default solver chain, certificate included) within this many seconds.
+BUDGET_S = 0.3
+
+
+def budget(repeat):
+    """Time one default design at δ̄ = 0.05 (best of ``repeat`` after a warm-up) against :data:`BUDGET_S`."""
+    sc = Scenario()
+    design_for_scenario(sc, 0.05)  # warm-up: imports and cvxpy's first canonicalisation
+    best = None
+    for _ in range(max(repeat, 3)):
+        t0, c0 = time.perf_counter(), time.process_time()
+        res = design_for_scenario(sc, 0.05)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        if best is None or wall < best[0]:
+            best = (wall, cpu, res)
+    wall, cpu, res = best
+    verdict = "within" if wall <= BUDGET_S else "OVER"
+    print(f"one design at δ̄ = 0.05 (default chain, certified): {wall:.3f} s wall, {cpu:.3f} s CPU, best of "
+          f"{max(repeat, 3)}; budget {BUDGET_S} s: {verdict} (solver {res.solver}, {res.method}, γ = {res.gamma:.10g})")
+    return wall
 
 
 def run(solver, repeat, form="general"):
-    label = solver or "default (CLARABEL + CVXOPT)"
+    label = solver or "default (CVXOPT, Clarabel fallback)"
     print(f"\n== form: {form}, solver: {label} ==")
     print(f"{'δ̄':>6} {'γ* certified':>14} {'solver γ':>14} {'worst ‖Ψ‖∞':>14} {'used':>9} {'method':>9} {'solve s':>8} {'total s':>8}")
     best = None
@@ -58,7 +82,11 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=1, help="repetitions; the fastest is reported (default 1)")
     parser.add_argument("--form", choices=("general", "observer", "both"), default="both", help="filter form(s) (default both)")
+    parser.add_argument("--budget-only", action="store_true", help="only time one design at δ̄ = 0.05 against the budget")
     args = parser.parse_args()
+    budget(args.repeat)
+    if args.budget_only:
+        return
     forms = ("general", "observer") if args.form == "both" else (args.form,)
     default = {}
     for form in forms:

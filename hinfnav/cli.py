@@ -261,8 +261,8 @@ def _parser():
     d = sub.add_parser("design", help="design a robust H-infinity filter by LMI (Corollary 1) and certify it")
     d.add_argument("--delta-bar", type=float, default=0.05, help="uncertainty bound delta_bar >= 0 (default 0.05)")
     _lazy(d.add_argument("--solver", default=None, type=str.upper,
-                         help="SDP solver (default: CLARABEL, polished by CVXOPT; SCS is slow and loose, with a "
-                              "warning)"), SOLVER_CHOICES)
+                         help="SDP solver (default: CVXOPT, then CLARABEL if CVXOPT certifies nothing; SCS is slow and "
+                              "loose, with a warning)"), SOLVER_CHOICES)
     d.add_argument("--form", default="general", choices=("general", "observer"),
                    help="filter structure: general (the paper's LMI (20), default) or observer "
                         "(extension: error independent of the trajectory)")

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import scipy.signal
 from numpy.typing import NDArray
 
 from .core.exceptions import InputError
@@ -142,10 +143,17 @@ class ColoredNoise(NoiseModel):
             raise InputError(f"colored noise needs a shape (..., n_steps, dim) with a time axis; got {shape}")
         xi = rng.standard_normal(shape)
         out = np.empty(shape)
+        if shape[-2] == 0:
+            return out
         a, b = self.a, np.sqrt(1.0 - self.a**2)
         out[..., 0, :] = xi[..., 0, :]
-        for k in range(1, shape[-2]):
-            out[..., k, :] = a * out[..., k - 1, :] + b * xi[..., k, :]
+        if shape[-2] > 1:
+            # n(k) = b ξ(k) + a n(k−1) for k ≥ 1 as one IIR filter along the time axis, each
+            # sequence contiguous (time last); the initial state a n(0) makes the first output
+            # b ξ(1) + a n(0), the recursion's, and lfilter adds in the recursion's order.
+            seq = np.moveaxis(xi, -2, -1).reshape(-1, shape[-2])
+            filtered = scipy.signal.lfilter([b], [1.0, -a], seq[:, 1:], axis=-1, zi=a * seq[:, :1])[0]
+            out[..., 1:, :] = np.moveaxis(filtered.reshape(shape[:-2] + (shape[-1], shape[-2] - 1)), -1, -2)
         return out
 
 

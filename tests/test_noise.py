@@ -47,6 +47,28 @@ def test_colored_noise_autocorrelation():
         assert rho == pytest.approx(m.a**lag, abs=0.01)
 
 
+def _colored_by_recursion(m, xi):
+    # the Gauss–Markov recursion n(k) = a n(k−1) + √(1−a²) ξ(k), n(0) = ξ(0), written out step by step
+    # (the loop hinfnav.noise used before issue 21): the independent reference for the lfilter path
+    out = np.empty_like(xi)
+    a, b = m.a, np.sqrt(1.0 - m.a**2)
+    out[..., 0, :] = xi[..., 0, :]
+    for k in range(1, xi.shape[-2]):
+        out[..., k, :] = a * out[..., k - 1, :] + b * xi[..., k, :]
+    return out
+
+
+@pytest.mark.parametrize("shape", [(300, 2), (4, 250, 3), (2, 3, 40, 1), (1, 1), (5, 1, 2)])
+def test_colored_noise_equals_the_recursion(shape):
+    # same ξ (same seed) through the old step loop and the IIR filter: equal to 1e-12 relative
+    # (both compute b ξ(k) + a n(k−1) in the same order, so they agree to rounding)
+    m = ColoredNoise(tau_s=0.7, dt=0.1)
+    got = m.sample(np.random.default_rng(11), shape)
+    xi = np.random.default_rng(11).standard_normal(shape)
+    np.testing.assert_allclose(got, _colored_by_recursion(m, xi), rtol=1e-12, atol=0)
+    assert m.sample(np.random.default_rng(0), (3, 0, 2)).shape == (3, 0, 2)
+
+
 @pytest.mark.parametrize("name", NOISE_NAMES)
 def test_same_seed_same_numbers(name):
     m = make_noise(name)

@@ -24,6 +24,7 @@ from ...core.validation import as_int_at_least
 from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
 from ...sim.truth import Truth, simulate_truth
+from .chaser import run_passes
 from .constants import (
     DEFAULT_AA,
     DEFAULT_ST,
@@ -249,6 +250,21 @@ def run_batched(builder, key, values, truth, scenario, *, labels=None, keep=Fals
     return out
 
 
+def _main_and_sweeps(builder, key, diag, truth, main_params, sweeps, scenario, eps0):
+    """The main runs of one filter (histories kept) and its sweeps, one pass; returns (main stats, [sweep stats]).
+
+    ``sweeps``: ``(truth, run parameters, recorded parameters, label, keep histories)`` per sweep value.
+    """
+    passes = [(truth, main_params)] + [(small, params) for small, params, _, _, _ in sweeps]
+    errors, hist = run_passes(builder, passes, scenario, diagnostics=diag)
+    diagnostics = hist.diagnostics
+    main = filter_stats(key, errors[0], truth.t, scenario, params=dict(est_params(key, eps0)), keep=True,
+                        diagnostics=diagnostics)
+    out = [filter_stats(label, err, small.t, scenario, params=record, keep=keep)
+           for err, (small, _, record, label, keep) in zip(errors[1:], sweeps)]
+    return main, out
+
+
 @dataclass(frozen=True, eq=False)
 class AttitudeStudy:
     """Everything the figures, the claims and ``summary.json`` read.
@@ -306,25 +322,28 @@ def attitude_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, Qs=Q_SWEE
     small = first_runs(truth, sweep_runs)
     bar.update(1)
     eps0 = default_epsilon(omega_e=scenario.omega_e)
-    main = {}
-    for key, est, diag in (("aekf", build_aekf(scenario), ()),
-                           ("astekf", build_astekf(scenario), ("fading", "fading_c")),
-                           ("aaekf", build_aaekf(scenario, epsilon=eps0), ("q_adapted", "input_rate"))):
-        main[key] = run_filter(key, est, truth, scenario, params=dict(est_params(key, eps0)), keep=True, diagnostics=diag)
-        bar.update(1)
     Qs = [float(q) for q in Qs]
     labels = [f"Q={q:.0e}" for q in Qs]
     sweep = {"Q": Qs}
-    sweep["aekf"] = run_batched(build_aekf, "Q", Qs, small, scenario, labels=labels, keep=True)
-    bar.update(1)
-    sweep["astekf"] = run_batched(build_astekf, "Q", Qs, small, scenario, labels=labels, keep=True)
-    bar.update(1)
-    st_grid = run_batched(build_astekf, ("rho", "beta"), ST_GRID, small, scenario, Q=PAPER_Q_ASTEKF)
-    bar.update(1)
-    eps = [f * eps0 for f in EPSILON_FACTORS]
-    eps_sweep = run_batched(build_aaekf, "epsilon", eps, small, scenario,
-                            labels=[f"ε={f:g}×default" for f in EPSILON_FACTORS])
-    bar.update(1)
+    main = {}
+    # each filter's main runs and its sweeps in one pass (run_passes): the numbers of separate passes
+    q_sweep = [(small, {"Q": q}, {"Q": q}, label, True) for q, label in zip(Qs, labels)]
+    main["aekf"], sweep["aekf"] = _main_and_sweeps(build_aekf, "aekf", (), truth, {"Q": PAPER_Q_BEST_AEKF}, q_sweep,
+                                                   scenario, eps0)
+    bar.update(2)
+    st = dict(Q=PAPER_Q_ASTEKF, rho=DEFAULT_ST["rho"], beta=DEFAULT_ST["beta"])
+    st_sweeps = [(small, dict(st, Q=q), {"Q": q}, label, True) for q, label in zip(Qs, labels)]
+    st_sweeps += [(small, dict(st, rho=r, beta=b), {"rho": r, "beta": b}, f"rho={r:g}, beta={b:g}", False)
+                  for r, b in ST_GRID]
+    main["astekf"], st_out = _main_and_sweeps(build_astekf, "astekf", ("fading", "fading_c"), truth, st, st_sweeps,
+                                              scenario, eps0)
+    sweep["astekf"], st_grid = st_out[:len(Qs)], st_out[len(Qs):]
+    bar.update(3)
+    eps_sweeps = [(small, {"epsilon": f * eps0}, {"epsilon": f * eps0}, f"ε={f:g}×default", False)
+                  for f in EPSILON_FACTORS]
+    main["aaekf"], eps_sweep = _main_and_sweeps(build_aaekf, "aaekf", ("q_adapted", "input_rate"), truth,
+                                                {"epsilon": eps0}, eps_sweeps, scenario, eps0)
+    bar.update(2)
     win_sweep = [run_filter(f"m={m}", build_aaekf(scenario, epsilon=eps0, memory_steps=m), small, scenario, params={"window": m})
                  for m in WINDOW_VALUES]
     bar.update(1)

