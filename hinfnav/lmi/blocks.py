@@ -80,12 +80,7 @@ def lmi20_matrix(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, L: Arra
         [Z((l, n)), Z((l, n)), L, -Cbar_F, Z((l, p)), Z((l, q)), -I(l)],
     ]
     if H is not None:
-        r = H.shape[1]
-        rows[2][2] = -R + lam * (E.T @ E)
-        extra = [R @ H, S @ H] + [Z((k, r)) for k in (n, n, p, q, l)]
-        for row, blk in zip(rows, extra):
-            row.append(blk)
-        rows.append([(R @ H).T, (S @ H).T, Z((r, n)), Z((r, n)), Z((r, p)), Z((r, q)), Z((r, l)), -lam * I(r)])
+        _border_uncertainty(rows, R, S, H, E, lam, (n, p, q, l))
     return bmat(rows)
 
 
@@ -151,13 +146,26 @@ def observer_lmi_matrix(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, 
         [Z((l, n)), Z((l, n)), Z((l, n)), L, Z((l, p)), Z((l, q)), -I(l)],
     ]
     if H is not None:
-        r = H.shape[1]
-        rows[2][2] = -X + lam * (E.T @ E)
-        extra = [X @ H, S @ H] + [Z((k, r)) for k in (n, n, p, q, l)]
-        for row, blk in zip(rows, extra):
-            row.append(blk)
-        rows.append([(X @ H).T, (S @ H).T, Z((r, n)), Z((r, n)), Z((r, p)), Z((r, q)), Z((r, l)), -lam * I(r)])
+        _border_uncertainty(rows, X, S, H, E, lam, (n, p, q, l))
     return bmat(rows)
+
+
+def _border_uncertainty(rows: list, P: Any, S: Any, H: ArrayLike, E: ArrayLike, lam: Any,
+                        dims: tuple[int, int, int, int]) -> None:
+    """Add the λ border of Lemma 2 (``ΔA = H F E``) to the 7×7 block rows of LMI (20) or its observer form, in place.
+
+    ``P`` is the block at (1, 1) and (3, 3) (``R`` in (20), ``X`` in the observer
+    form): the (3, 3) block gains ``λ EᵀE``, and a last block row/column
+    ``[P H, S H, 0, 0, 0, 0, 0, −λI]`` is appended; ``dims = (n, p, q, l)``.
+    """
+    n, p, q, l = dims
+    r = H.shape[1]
+    Z = np.zeros
+    rows[2][2] = -P + lam * (E.T @ E)
+    extra = [P @ H, S @ H] + [Z((k, r)) for k in (n, n, p, q, l)]
+    for row, blk in zip(rows, extra):
+        row.append(blk)
+    rows.append([(P @ H).T, (S @ H).T, Z((r, n)), Z((r, n)), Z((r, p)), Z((r, q)), Z((r, l)), -lam * np.eye(r)])
 
 
 def gamma_index(n: int, p: int, q: int) -> NDArray[np.intp]:
