@@ -44,7 +44,7 @@ from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
 from .explain import small_gain_number, unstable_plant_message
-from .result import SynthesisResult
+from .result import FilterDesign, SynthesisResult
 
 __all__ = ["LYAPUNOV", "COVERS", "PolytopicResult", "synthesize_polytopic", "certify_polytopic",
            "sampled_norms", "error_coordinates", "observer_nominal"]
@@ -61,7 +61,7 @@ COVERS = {
 
 
 @dataclass(frozen=True, eq=False)
-class PolytopicResult:
+class PolytopicResult(FilterDesign):
     """A certified H∞ filter for a polytopic system.
 
     Attributes
@@ -96,13 +96,6 @@ class PolytopicResult:
         ``sample_norms`` are H2 norms (bound and sampled), ``witness`` has W.
     """
 
-    A_F: np.ndarray
-    B_F: np.ndarray
-    C_F: np.ndarray
-    gamma: float
-    lmi_gamma: float
-    verified_norm: float
-    sample_norms: np.ndarray
     alphas: np.ndarray
     worst_sample: int
     spectral_radius: float
@@ -117,10 +110,6 @@ class PolytopicResult:
     attempts: tuple = ()
     system: object = None
     objective: str = "hinf"
-
-    def statespace(self) -> control.StateSpace:
-        """The filter as a discrete :class:`control.StateSpace` (y → z_f)."""
-        return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
 
 
 def _vertex_tuples(system):

@@ -15,14 +15,48 @@ from ..analysis.error_system import error_system
 if TYPE_CHECKING:
     from ..systems.uncertain import UncertainSystem
 
-__all__ = ["SynthesisResult"]
+__all__ = ["FilterDesign", "SynthesisResult"]
 
 #: Attribute names before issue 23 (Sun 2011's δ grid) -> the generic names; kept until 0.3, warned.
 _RENAMED = {"delta_bar": "uncertainty_bound", "deltas": "sample_values", "worst_delta": "worst_value"}
 
 
 @dataclass(frozen=True, eq=False)
-class SynthesisResult:
+class FilterDesign:
+    """What every certified filter design holds first: the filter (12) and its levels.
+
+    The common head of :class:`SynthesisResult` (norm-bounded uncertainty) and
+    :class:`~hinfnav.design.polytopic.PolytopicResult` (a polytope), whose
+    attributes say what each level certifies.
+
+    Attributes
+    ----------
+    A_F, B_F, C_F : ndarray
+        The filter ``x_f(k+1) = A_F x_f(k) + B_F y(k)``, ``z_f = C_F x_f``.
+    gamma : float
+        Certified level.
+    lmi_gamma : float
+        The solver's level.
+    verified_norm : float
+        Largest sampled norm of the error system (a lower bound of the worst case).
+    sample_norms : ndarray, shape (K,)
+    """
+
+    A_F: np.ndarray
+    B_F: np.ndarray
+    C_F: np.ndarray
+    gamma: float
+    lmi_gamma: float
+    verified_norm: float
+    sample_norms: np.ndarray
+
+    def statespace(self) -> control.StateSpace:
+        """The filter as a discrete :class:`control.StateSpace` (y → z_f), with the design's ``dt``."""
+        return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
+
+
+@dataclass(frozen=True, eq=False)
+class SynthesisResult(FilterDesign):
     """A certified robust H∞ filter (12) from Theorem 1 / Corollary 1.
 
     Attributes
@@ -86,13 +120,6 @@ class SynthesisResult:
         that a design can be saved with its own system.
     """
 
-    A_F: np.ndarray
-    B_F: np.ndarray
-    C_F: np.ndarray
-    gamma: float
-    lmi_gamma: float
-    verified_norm: float
-    sample_norms: np.ndarray
     worst_sample: int
     spectral_radius: float
     solver: str
@@ -109,10 +136,6 @@ class SynthesisResult:
     form: str = "general"
     sample_labels: tuple = ()
     system: object = None
-
-    def statespace(self) -> control.StateSpace:
-        """The filter as a discrete :class:`control.StateSpace` (y → z_f), with ``dt``."""
-        return control.ss(self.A_F, self.B_F, self.C_F, np.zeros((self.C_F.shape[0], self.B_F.shape[1])), self.dt)
 
     @property
     def worst_value(self) -> float | None:

@@ -175,12 +175,7 @@ class AugmentedEKF(KalmanCore):
     def _start(self, xhat0, P0, runs):
         if self.parameter_runs is not None and runs != self.parameter_runs:
             raise InputError(f"runs must equal the number of per-run parameter values ({self.parameter_runs}); got {runs}")
-        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
-        x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
-        x = np.broadcast_to(x0, (runs, x0.size)).copy()
-        if not self.shares_covariance:
-            P = np.broadcast_to(P, (runs,) + P.shape).copy()
-        return FilterState(x=x, P=P)
+        return super()._start(xhat0, P0, runs)
 
     def _predict(self, state, u):
         if self.uses_input and u is None:

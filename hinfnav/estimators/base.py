@@ -39,9 +39,9 @@ on, a saturated-measurement filter the update when a channel is clipped.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -56,7 +56,7 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "MISSING", "PHASES", "available_channels"]
+           "store_diagnostics", "MISSING", "PHASES", "available_channels"]
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
@@ -179,6 +179,21 @@ def history_keys(keep_covariance, diagnostics):
         return set(diagnostics)
     except TypeError:
         raise InputError(f"diagnostics must be True, False or names of diagnostics; got {diagnostics!r}") from None
+
+
+def store_diagnostics(diag: dict[str, np.ndarray], step: Mapping[str, Any], keys: set[str] | None, k: int, runs: int,
+                      n_samples: int) -> None:
+    """Write the diagnostics ``step`` of step ``k`` into the histories ``diag`` (name -> (runs, n_samples, ...)), in place.
+
+    Only the names in ``keys`` are kept (None: all, as :func:`history_keys` returns); a
+    history is allocated at its first value, with that value's trailing shape and dtype.
+    """
+    for key, val in step.items():
+        if keys is None or key in keys:
+            val = np.asarray(val)
+            if key not in diag:
+                diag[key] = np.empty((runs, n_samples) + val.shape[1:], dtype=val.dtype)
+            diag[key][:, k] = val
 
 
 def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, n_state: int, n_meas: int | None = None,
@@ -451,12 +466,7 @@ class Estimator:
                     P_hist[k] = P if P.ndim == core else P[0]
                 else:
                     P_hist[:, k] = P
-            for key, val in out.diagnostics.items():
-                if keys is None or key in keys:
-                    val = np.asarray(val)
-                    if key not in diag:
-                        diag[key] = np.empty((runs, n1) + val.shape[1:], dtype=val.dtype)
-                    diag[key][:, k] = val
+            store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
             if k < n1 - 1:
                 state = self._predict(state, u[:, k])
         if shared:

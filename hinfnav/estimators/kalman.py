@@ -109,6 +109,10 @@ class KalmanCore(KalmanCorrection, Estimator):
         """The state corrected by ``dx`` (error coordinates); additive here."""
         return x + dx
 
+    def initial_internal(self, xhat0: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The internal state of the prior estimate ``xhat0`` (n,): the estimate itself here."""
+        return xhat0
+
     def report(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The estimate reported in the system's coordinates, (runs, system.n)."""
         return x
@@ -169,6 +173,16 @@ class KalmanCore(KalmanCorrection, Estimator):
         return self.inject(x, dx), P_post, diag
 
     # -- the step contract --------------------------------------------------------
+
+    def _start(self, xhat0, P0, runs):
+        """x̂ of every run at ``initial_internal(xhat0)``; P = P0 (the filter's default when None), one per run
+        unless the covariance is shared."""
+        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
+        x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
+        x = np.broadcast_to(x0, (runs, x0.size)).copy()
+        if not self.shares_covariance:
+            P = np.broadcast_to(P, (runs,) + P.shape).copy()
+        return FilterState(x=x, P=P)
 
     def _update(self, state, y):
         """The one update of the Kalman core: predicted reading, deferred prior, correction, report."""
@@ -320,13 +334,6 @@ class ExtendedKalmanFilter(KalmanCore):
         return self.Q, {}
 
     # -- the step contract --------------------------------------------------------
-
-    def _start(self, xhat0, P0, runs):
-        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_state, definite=True)
-        x = np.broadcast_to(np.asarray(xhat0, dtype=float), (runs, self.n_state)).copy()
-        if not self.shares_covariance:
-            P = np.broadcast_to(P, (runs,) + P.shape).copy()
-        return FilterState(x=x, P=P)
 
     def _predict(self, state, u):
         if self.uses_input and u is None:
