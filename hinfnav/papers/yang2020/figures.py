@@ -89,10 +89,12 @@ def _decimate(n, target=6000):
 
 
 def _span(result, span_s):
-    """Sample indices ``k0, k1`` of the time span ``span_s`` (s), clipped to the run, and the plot's decimation."""
+    """``k0, k1, s, t``: sample indices of the time span ``span_s`` (s), clipped to the run, the plot's
+    decimation ``s`` and the decimated times ``t`` (s) of the span."""
     k0, k1 = (int(v / result.settings["dt"]) for v in span_s)
     k1 = min(k1, result.x.shape[1])
-    return k0, k1, _decimate(k1 - k0)
+    s = _decimate(k1 - k0)
+    return k0, k1, s, result.t[k0:k1][s]
 
 
 def fig5(result, *, axis=0, run=0):
@@ -186,8 +188,8 @@ def fig9(results, *, axis=0, run=0, span_s=(2000.0, 6000.0)):
     fig, axes = new_figure(1, 1, figsize=(8, 4))
     ax = axes[0, 0]
     for i, (label, res) in enumerate(results.items()):
-        k0, k1, s = _span(res, span_s)
-        ax.plot(res.t[k0:k1][s], 1e6 * res.x[run, k0:k1, 6 + axis][s], lw=0.8, label=label, color=f"C{i}")
+        k0, k1, s, t = _span(res, span_s)
+        ax.plot(t, 1e6 * res.x[run, k0:k1, 6 + axis][s], lw=0.8, label=label, color=f"C{i}")
     ax.set_yscale("symlog", linthresh=1e-3)
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("r$_{rel,x}$ (µm, symlog)")
@@ -200,8 +202,7 @@ def fig9(results, *, axis=0, run=0, span_s=(2000.0, 6000.0)):
 def fig10(result, *, run=0, span_s=(2000.0, 9000.0)):
     """Steady state under ADRC: φ_sc, r_rel, φ_rel (three axes each)."""
     fig, axes = new_figure(3, 1, figsize=(8, 7), sharex=True)
-    k0, k1, s = _span(result, span_s)
-    t = result.t[k0:k1][s]
+    k0, k1, s, t = _span(result, span_s)
     for row, (sl, unit, name) in enumerate(((slice(0, 3), "rad", "φ$_{sc}$"), (slice(6, 9), "m", "r$_{rel}$"),
                                             (slice(12, 15), "rad", "φ$_{rel}$"))):
         for a, lab in enumerate(("x/pitch", "y/yaw", "z/roll")):
@@ -217,8 +218,7 @@ def fig10(result, *, run=0, span_s=(2000.0, 9000.0)):
 def fig11(result, *, run=0, around_s=(9500.0, 21500.0)):
     """The attitude step of Section 3 (on at 1e4 s, off at 2e4 s) and the relative attitude."""
     fig, axes = new_figure(2, 1, figsize=(8, 6), sharex=True)
-    k0, k1, s = _span(result, around_s)
-    t = result.t[k0:k1][s]
+    k0, k1, s, t = _span(result, around_s)
     for a, lab in enumerate(("pitch", "yaw", "roll")):
         axes[0, 0].plot(t, result.x[run, k0:k1, a][s], lw=0.8, label=lab, color=f"C{a}")
         axes[0, 0].plot(t, result.reference[k0:k1, a][s], "--", lw=0.6, color=f"C{a}")
