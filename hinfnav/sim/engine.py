@@ -44,7 +44,7 @@ from tqdm import tqdm
 from ..core.exceptions import InputError
 from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
-from ..estimators.base import EstimateHistory, Estimator, history_keys
+from ..estimators.base import EstimateHistory, Estimator, history_keys, store_diagnostics
 from ..estimators.registry import build_estimator
 from .result import SimulationResult
 from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, scenario_truth_model, simulate_truth
@@ -108,10 +108,10 @@ def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
     """Name → Estimator from one estimator, a sequence of them, or a mapping name → estimator (names unique)."""
     if isinstance(estimators, Mapping):
         items = [(str(k), v) for k, v in estimators.items()]
-    elif isinstance(estimators, (str, Estimator, SynthesisResult)) or estimators is None:
-        items = [(None, estimators)]
-    else:
+    elif isinstance(estimators, Sequence) and not isinstance(estimators, str):
         items = [(None, e) for e in estimators]
+    else:  # one estimator, a name or a design (a design's type is the scenario's to check: not imported here)
+        items = [(None, estimators)]
     if not items:
         raise InputError("estimators must hold at least one estimator")
     out = {}
@@ -236,12 +236,7 @@ def closed_loop_batch(model: TruthModel, estimator: Estimator, controller: Calla
             if P_hist is None:
                 P_hist = np.empty((runs, n1) + P.shape[-(1 if keep_covariance == "diagonal" else 2):])
             P_hist[:, k] = P
-        for key, val in out.diagnostics.items():
-            if keys is None or key in keys:
-                val = np.asarray(val)
-                if key not in diag:
-                    diag[key] = np.empty((runs, n1) + val.shape[1:], dtype=val.dtype)
-                diag[key][:, k] = val
+        store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
         u[:, k] = controller(x[:, k] if on_truth else xhat[:, k])
         if k < n1 - 1:
             x[:, k + 1] = (step(x[:, k], u[:, k], w[:, k], t[k]) if callable(step)
