@@ -52,7 +52,7 @@ from ..core.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
 from ..metrics.consistency import NIS_KEYS, initial_scale, warn_if_diverged
 from ..sim.montecarlo import check_measurement_match
-from ..sim.truth import simulate_truth
+from ..sim.truth import child_rngs, simulate_truth
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
 from .stats import CellAccumulator
@@ -161,7 +161,7 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     for start in range(0, runs, bs):
         n = min(bs, runs - start)
         t0, c0 = time.perf_counter(), time.process_time()
-        truth = simulate_truth(model, noise=unit["noise"], runs=n, seed=unit["seed"], first_run=start)
+        truth = _truth_batch(scenario, model, unit, n, start)
         truth_s += time.perf_counter() - t0
         truth_cpu += time.process_time() - c0
         for c in cells:
@@ -194,6 +194,16 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
             res.update(status="diverged" if blown else "ok", diverged=stats["consistency"]["diverged"], statistics=stats)
         out.append(res)
     return out
+
+
+def _truth_batch(scenario, model, unit, runs, start):
+    """Runs ``start … start + runs − 1`` of a unit's truth: the scenario's own ``campaign_truth(conditions, noise,
+    rngs)`` when it has one (a nonlinear truth, an impulse…; ``rngs`` the runs' child generators of the cell seed,
+    as :func:`~hinfnav.sim.truth.simulate_truth` draws them), else the linear :func:`simulate_truth` of ``model``."""
+    own = getattr(scenario, "campaign_truth", None)
+    if own is None:
+        return simulate_truth(model, noise=unit["noise"], runs=runs, seed=unit["seed"], first_run=start)
+    return own(unit["conditions"], unit["noise"], child_rngs(unit["seed"], start + runs)[start:])
 
 
 def _run_cell_batch(est, truth, xhat0, acc, start):

@@ -19,6 +19,7 @@ from .grid import (
     fit_matrix,
     load_papers,
 )
+from . import estimators as _estimators  # noqa: F401  (registers the generic filters)
 from .limits import cell_kalman_limit
 from .reproduce import reproduce
 from .table import QUANTITIES, benchmark_table, best_by_condition, format_markdown, plot_heatmap

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
-from ...estimators.registry import register_estimator
+from ...estimators.registry import Requires, register_estimator
 from .constants import published_filter
 from .designs import design_for_scenario
 from .ekf import build_ekf
@@ -140,4 +140,5 @@ def _builder(name):
 
 
 for _name in FILTER_NAMES:
-    register_estimator(_name, _builder(_name), fits=_fits, description=_DESCRIPTIONS[_name])
+    register_estimator(_name, _builder(_name), fits=_fits, description=_DESCRIPTIONS[_name],
+                       requires=Requires(model="sun2011", linear=not _name.startswith("ekf"), input=_name in ("ekf_known_input", "published", "designed", "designed_observer")))
