@@ -105,7 +105,10 @@ class CampaignScenario(Scenario):
                 "input_rate_max": 1e-3, "input_std0": 1e-3}
 
     def bound_problem(self, conditions, noise):
-        """Ingredients of the posterior CRB: F = Φ, H of the sensor, Q = B Bᵀ, Λ of the sensor noise, P₀.
+        """Ingredients of the posterior CRB: F = Φ, H of the sensor, Q = B Bᵀ, Λ of the sensor noise, P₀ = 0.
+
+        The truth starts from one fixed state (and the maneuver is a fixed impulse): the bound's prior is that
+        state (P₀ = 0), which makes it a strict bound for every estimator, none of which knows it.
 
         Λ is ``j (D Dᵀ)⁻¹`` with j the Fisher information of the sensor's noise density
         (:func:`hinfnav.analysis.pcrb.measurement_information`); for the contaminated
@@ -118,7 +121,7 @@ class CampaignScenario(Scenario):
         else:
             Lam = measurement_information(sensor.D, v)
         return {"kind": "pcrb", "F": system.Phi, "H": sensor, "Q": system.B @ system.B.T, "Lambda": Lam,
-                "P0": self.P0, "states": lambda x: x}
+                "P0": np.zeros((6, 6)), "states": lambda x: x}
 
 
 register_scenario("shi2018", CampaignScenario,
