@@ -51,8 +51,17 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
     _SCENARIOS[name] = _ScenarioEntry(name, factory, description)
 
 
+_LOADED = {"providers": False}
+
+
 def registered_scenarios() -> tuple[str, ...]:
-    """Names of the registered scenarios, in registration order."""
+    """Names of the registered scenarios, in registration order.
+
+    The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
+    """
+    if not _LOADED["providers"]:
+        _LOADED["providers"] = True
+        load_providers()
     return tuple(_SCENARIOS)
 
 
