@@ -57,7 +57,8 @@ def _markdown(table, best, note):
 
 
 def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, notebooks=False, progress=True,
-              client=None, campaign_dir=None, scenarios=None, grids=None, bound_runs=BOUND_RUNS, workers=None):
+              client=None, campaign_dir=None, scenarios=None, grids=None, estimators=None, bound_runs=BOUND_RUNS,
+              workers=None):
     """Run the cross-paper benchmark and write its tables, heat maps and summary into ``out_dir``.
 
     Parameters
@@ -77,6 +78,8 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
         Default: every scenario of :data:`~.grid.SCENARIOS`.
     grids : dict, optional
         Scenario → grid entries replacing the benchmark's (a smaller grid for a quick look).
+    estimators : dict, optional
+        Scenario → estimator names (default: every registered estimator that fits it).
     bound_runs : int
         Truth runs of each posterior CRB.
     workers : int, optional
@@ -103,10 +106,12 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
         if err is not None and progress:
             tqdm.write(f"paper {key} could not be imported, its scenario and estimators are left out: {err}")
     cdir = Path(campaign_dir) if campaign_dir is not None else out / "campaign"
+    chosen = dict(estimators or {})
     tables, errors, estimators, unfit, cpu = [], {}, {}, {}, 0.0
     with campaign_client(client, workers=workers) as dask_client:
         for key in keys:
-            campaign = scenario_campaign(key, runs=runs, seed=seed, grid=(grids or {}).get(key))
+            campaign = scenario_campaign(key, runs=runs, seed=seed, grid=(grids or {}).get(key),
+                                         estimators=chosen.get(key))
             settings = {k: v[0] for k, v in campaign.grid.items() if k in scenario_parameters(key)}
             estimators[key] = list(campaign.grid["estimator"])
             unfit[key] = non_fitting(key, settings)
