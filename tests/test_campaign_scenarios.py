@@ -64,7 +64,7 @@ def test_shi_truth_draws_do_not_depend_on_the_batch_and_the_maneuver_is_the_only
 
 def _campaigns():
     return [Campaign(name="shi", runs=3, batch_size=2, seed=1, windows={"w": (100.0, 1000.0)},
-                     grid={"scenario": "shi2018", "estimator": ["ekf_converted", "model_ekf"], 
+                     grid={"scenario": "shi2018", "estimator": ["ekf_converted", "model_ekf"],
                            "maneuver": [True], "noise": ["mixture"]}),
             Campaign(name="att", runs=3, batch_size=2, seed=1, windows={"w": (100.0, 292.0)},
                      grid={"scenario": "attitude2018", "estimator": ["aekf"], "orbits": [0.05]})]

@@ -33,6 +33,8 @@ from ...estimators.sigma_point import SigmaPointFilter
 from ..attitude2018.constants import PAPER_Q_BEST_AEKF
 from ..attitude2018.filters import torque_density
 from ..attitude2018.scenario import Scenario as AttitudeScenario
+from ..shi2018.campaign import kalman_model as shi_kalman_model
+from ..shi2018.scenario import Scenario as ShiScenario
 
 __all__ = ["GENERIC", "build_generic", "build_attitude_hbf"]
 
@@ -48,9 +50,11 @@ GENERIC = {
 
 def _model(scenario):
     model = getattr(scenario, "kalman_model", None)
-    if not callable(model):
-        raise InputError(f"scenario {type(scenario).__name__} offers no kalman_model()")
-    return model()
+    if callable(model):
+        return model()
+    if isinstance(scenario, ShiScenario):  # the paper's own scenario object (not the campaign's): the same model
+        return shi_kalman_model(scenario)
+    raise InputError(f"scenario {type(scenario).__name__} offers no kalman_model()")
 
 
 def build_generic(kind, scenario, **options):
@@ -87,7 +91,7 @@ def _builder(kind):
 
 
 def _has_model(scenario):
-    return callable(getattr(scenario, "kalman_model", None))
+    return callable(getattr(scenario, "kalman_model", None)) or isinstance(scenario, ShiScenario)
 
 
 for _name, (_kind, _text) in GENERIC.items():

@@ -33,10 +33,20 @@ from ...sim.truth import Truth, TruthModel, draw_noise
 from .constants import MIXTURE_EPS, MIXTURE_RATIO
 from .scenario import ContaminatedNoise, Scenario
 
-__all__ = ["CampaignScenario", "OFFERS"]
+__all__ = ["CampaignScenario", "OFFERS", "kalman_model"]
 
 #: Additive error, range/angle readings, the control acceleration known, linear (Hill/CW) dynamics.
 OFFERS = Offers(error_form="additive", measurement="range_angle", input=True, linear=True, models=("shi2018", "kalman"))
+
+
+def kalman_model(scenario):
+    """The generic filters' model on a Shi & Wang :class:`~.scenario.Scenario`: Hill/CW with the known control
+    acceleration, the direct range/angle sensor, the scenario's P₀; an unknown input of at most 1e-3 m/s³ in
+    rate and 1e-3 m/s² at the start (documented choice, for the adaptive filter)."""
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a hinfnav Shi 2018 Scenario; got {type(scenario).__name__}")
+    return {"system": scenario.system(), "measurement": scenario.sensor(), "P0": scenario.P0, "uses_input": True,
+            "input_rate_max": 1e-3, "input_std0": 1e-3}
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,9 +110,8 @@ class CampaignScenario(Scenario):
                      settings=settings, state=system.state, measurement=sensor)
 
     def kalman_model(self):
-        """The generic filters' model: Hill/CW with the known control acceleration, the direct range/angle sensor."""
-        return {"system": self.system(), "measurement": self.sensor(), "P0": self.P0, "uses_input": True,
-                "input_rate_max": 1e-3, "input_std0": 1e-3}
+        """The generic filters' model (:func:`kalman_model`)."""
+        return kalman_model(self)
 
     def bound_problem(self, conditions, noise):
         """Ingredients of the posterior CRB: F = Φ, H of the sensor, Q = B Bᵀ, Λ of the sensor noise, P₀ = 0.
