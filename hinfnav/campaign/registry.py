@@ -41,7 +41,13 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
     factory : callable
         Returns an object with ``truth_model(**conditions)`` and ``xhat0``
         (the scenario protocol of :mod:`hinfnav.sim`); called with no
-        argument it gives the paper's scenario.
+        argument it gives the paper's scenario. Optional: ``offers`` (an
+        :class:`~hinfnav.estimators.registry.Offers`: what its estimators may
+        rely on) and ``campaign_truth(conditions, noise, rngs)`` returning a
+        :class:`~hinfnav.sim.truth.Truth` (a truth the linear
+        :func:`~hinfnav.sim.truth.simulate_truth` cannot make: nonlinear
+        dynamics, an impulse, another noise per channel; the campaign runner
+        uses it when present).
     description : str
     """
     if not isinstance(name, str) or not name:
