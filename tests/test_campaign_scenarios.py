@@ -39,10 +39,10 @@ def test_the_five_families_on_the_scenarios_and_the_lmi_designs_only_where_linea
     fits = {k: set(registered_estimators(build_scenario(k))) for k in ("sun2011", "shi2018", "attitude2018", "yang2020")}
     # EKF, sigma-point, Huber, strong tracking and adaptive on each scenario (by their names there)
     assert {"ekf_known_input", "ukf", "hbf", "ekf_augmented_thrust_st", "ekf_augmented_thrust_adaptive"} <= fits["sun2011"]
-    assert {"aekf", "attitude_hbf", "astekf", "aaekf"} <= fits["attitude2018"]
+    assert {"aekf", "attitude_ukf", "attitude_hbf", "astekf", "aaekf"} <= fits["attitude2018"]
     for key in ("shi2018", "yang2020"):
         assert {"model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_adaptive"} <= fits[key]
-    # the sigma-point filter on the quaternion state: not fitting, with the reason
+    # the generic sigma-point filter (additive error) on the quaternion state: not fitting, with the reason
     assert "quaternion" in fit_reason("ukf", build_scenario("attitude2018"))
     assert "designed" in fits["sun2011"] and not any("designed" in fits[k] for k in ("shi2018", "attitude2018", "yang2020"))
     with pytest.raises(InputError, match="does not fit"):

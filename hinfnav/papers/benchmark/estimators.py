@@ -18,7 +18,10 @@ on its rate, input unit/s, and ``input_std0``, its initial σ). On it:
 
 and, for paper 002's attitude scenario (quaternion error: the five above do not fit it), ``attitude_hbf``:
 its AEKF with the Huber update (:class:`~hinfnav.estimators.attitude.AttitudeHuberEKF`, Q = 1e-14 I₃ as the
-paper's best AEKF, γ = 1.345), so that scenario has a Huber filter beside its AEKF, ASTEKF and AAEKF.
+paper's best AEKF, γ = 1.345), and ``attitude_ukf``: the sigma-point filter on the same model in the error
+coordinates (δθ, δω, δT) (the USQUE-type form (U6) of :mod:`hinfnav.estimators.sigma_point`; per-step
+process noise ``Δt Γ Q Γᵀ`` with the AEKF's Q = 1e-14 I₃, as the AEKF's prediction), so that scenario has a
+sigma-point and a Huber filter beside its AEKF, ASTEKF and AAEKF.
 """
 
 import numpy as np
@@ -30,13 +33,14 @@ from ...estimators.huber_filter import HuberFilter
 from ...estimators.kalman import ExtendedKalmanFilter, StrongTrackingEKF
 from ...estimators.registry import Requires, register_estimator
 from ...estimators.sigma_point import SigmaPointFilter
+from ...systems.attitude import AttitudeSystem
 from ..attitude2018.constants import PAPER_Q_BEST_AEKF
 from ..attitude2018.filters import torque_density
 from ..attitude2018.scenario import Scenario as AttitudeScenario
 from ..shi2018.campaign import kalman_model as shi_kalman_model
 from ..shi2018.scenario import Scenario as ShiScenario
 
-__all__ = ["GENERIC", "build_generic", "build_attitude_hbf"]
+__all__ = ["GENERIC", "build_generic", "build_attitude_hbf", "build_attitude_ukf"]
 
 #: Name → (kind, description).
 GENERIC = {
@@ -109,5 +113,22 @@ def build_attitude_hbf(scenario, *, Q=PAPER_Q_BEST_AEKF, gamma=1.345, **options)
 
 register_estimator("attitude_hbf", build_attitude_hbf, fits=lambda scenario: isinstance(scenario, AttitudeScenario),
                    description="paper 002's AEKF with the Huber update (gamma = 1.345)",
+                   requires=Requires(error_form="quaternion", measurement=("star_vectors",), input=True,
+                                     model="attitude2018"))
+
+
+def build_attitude_ukf(scenario, *, Q=PAPER_Q_BEST_AEKF, **options):
+    """Paper 002's attitude model under the sigma-point filter (see the module docstring); ``options`` to
+    :class:`~hinfnav.estimators.SigmaPointFilter` (``rule``, ``alpha``…)."""
+    if not isinstance(scenario, AttitudeScenario):
+        raise InputError(f"scenario must be a paper 002 (attitude2018) Scenario; got {type(scenario).__name__}")
+    system = scenario.system()
+    G = AttitudeSystem.noise_input()
+    return SigmaPointFilter(system, scenario.measurement, P0=scenario.P0, Q=system.dt * G @ torque_density(Q) @ G.T,
+                            uses_input=True, name="attitude_ukf", **options)
+
+
+register_estimator("attitude_ukf", build_attitude_ukf, fits=lambda scenario: isinstance(scenario, AttitudeScenario),
+                   description="paper 002's attitude model under the sigma-point (unscented) filter, Q = 1e-14 I3",
                    requires=Requires(error_form="quaternion", measurement=("star_vectors",), input=True,
                                      model="attitude2018"))
