@@ -44,10 +44,9 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
         argument it gives the paper's scenario. Optional: ``offers`` (an
         :class:`~hinfnav.estimators.registry.Offers`: what its estimators may
         rely on) and ``campaign_truth(conditions, noise, rngs)`` returning a
-        :class:`~hinfnav.sim.truth.Truth` (a truth the linear
-        :func:`~hinfnav.sim.truth.simulate_truth` cannot make: nonlinear
-        dynamics, an impulse, another noise per channel; the campaign runner
-        uses it when present).
+        :class:`~hinfnav.sim.truth.Truth` (a truth the simulators cannot make
+        from ``truth_model`` alone: an impulse, another noise per channel; the
+        campaign runner uses it when present, :func:`~hinfnav.campaign.runner.cell_truth`).
     description : str
     """
     if not isinstance(name, str) or not name:

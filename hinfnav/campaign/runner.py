@@ -52,6 +52,7 @@ from ..core.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
 from ..metrics.consistency import NIS_KEYS, initial_scale, warn_if_diverged
 from ..sim.montecarlo import check_measurement_match
+from ..sim.nonlinear import simulate_nonlinear_truth
 from ..sim.truth import child_rngs, simulate_truth
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
@@ -63,7 +64,8 @@ if TYPE_CHECKING:
 
     from .spec import Campaign
 
-__all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "SERIAL"]
+__all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "cell_truth",
+           "SERIAL"]
 
 #: ``client=SERIAL`` runs every task in this process, one after another (no cluster; for debugging and tests).
 SERIAL = "serial"
@@ -142,7 +144,6 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     _BUILT.update(unit.get("built", {}))  # the estimators built (and designed) once by the validation
     t_start, c_start = time.perf_counter(), time.process_time()
     scenario = _scenario(unit["scenario"], unit["settings"])
-    model = scenario.truth_model(**unit["conditions"])
     runs, bs = unit["runs"], unit["batch_size"]
     cells = unit["cells"]
     estimators, accs, errors = {}, {}, {}
@@ -161,7 +162,7 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     for start in range(0, runs, bs):
         n = min(bs, runs - start)
         t0, c0 = time.perf_counter(), time.process_time()
-        truth = _truth_batch(scenario, model, unit, n, start)
+        truth = cell_truth(scenario, unit["conditions"], unit["noise"], seed=unit["seed"], runs=n, first_run=start)
         truth_s += time.perf_counter() - t0
         truth_cpu += time.process_time() - c0
         for c in cells:
@@ -196,14 +197,21 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _truth_batch(scenario, model, unit, runs, start):
-    """Runs ``start … start + runs − 1`` of a unit's truth: the scenario's own ``campaign_truth(conditions, noise,
-    rngs)`` when it has one (a nonlinear truth, an impulse…; ``rngs`` the runs' child generators of the cell seed,
-    as :func:`~hinfnav.sim.truth.simulate_truth` draws them), else the linear :func:`simulate_truth` of ``model``."""
+def cell_truth(scenario, conditions, noise, *, seed, runs, first_run=0):
+    """Runs ``first_run … first_run + runs − 1`` of a cell's truth (:class:`~hinfnav.sim.truth.Truth`).
+
+    The scenario's own ``campaign_truth(conditions, noise, rngs)`` when it has one (an impulse, another noise per
+    channel…; ``rngs`` the runs' child generators of ``seed``, as the simulators draw them); else its
+    ``truth_model(**conditions)`` simulated by :func:`~hinfnav.sim.nonlinear.simulate_nonlinear_truth` when the
+    system steps itself (``step``: nonlinear dynamics), by the linear :func:`~hinfnav.sim.truth.simulate_truth`
+    otherwise. The same seed gives the same runs whatever the batches.
+    """
     own = getattr(scenario, "campaign_truth", None)
-    if own is None:
-        return simulate_truth(model, noise=unit["noise"], runs=runs, seed=unit["seed"], first_run=start)
-    return own(unit["conditions"], unit["noise"], child_rngs(unit["seed"], start + runs)[start:])
+    if own is not None:
+        return own(conditions, noise, child_rngs(seed, first_run + runs)[first_run:])
+    model = scenario.truth_model(**conditions)
+    simulate = simulate_nonlinear_truth if callable(getattr(model.system, "step", None)) else simulate_truth
+    return simulate(model, noise=noise, runs=runs, seed=seed, first_run=first_run)
 
 
 def _run_cell_batch(est, truth, xhat0, acc, start):

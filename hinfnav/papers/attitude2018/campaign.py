@@ -5,10 +5,10 @@ filters build on it unchanged; ``T0`` and ``orbits`` are among its settings)
 with what a campaign needs:
 
 * ``truth_model(hold)``: the rigid body under T_d(t) with the attitude-hold law;
-* ``campaign_truth(conditions, noise, rngs)``: that truth stepped
-  (:meth:`~hinfnav.systems.attitude.AttitudeSystem.step`, RK4) with the
-  star-sensor noise of the campaign's ``noise`` drawn from the runs'
-  generators (the truth has no process noise: T_d is given);
+* no ``campaign_truth`` of its own: the campaign runner steps that truth
+  (:meth:`~hinfnav.systems.attitude.AttitudeSystem.step`, RK4) by
+  :func:`~hinfnav.sim.nonlinear.simulate_nonlinear_truth`, the star-sensor noise
+  the campaign's ``noise`` (the truth has no process noise: T_d is given);
 * ``bound_problem(conditions, noise)``: the posterior Cramér–Rao bound in the
   error coordinates (δθ, δω) of an estimator that knows T_d(t), the hold law
   and the prior N(x₀, P₀) of the filters (the torque error is then zero): F the
@@ -27,7 +27,6 @@ from ...analysis.pcrb import measurement_information
 from ...campaign.registry import register_scenario
 from ...estimators.registry import Offers
 from ...noise import make_noise
-from ...sim.truth import Truth, draw_noise
 from ...systems.attitude import quat_from_rotvec, rotvec_from_quat
 from .scenario import Scenario
 
@@ -43,30 +42,6 @@ class CampaignScenario(Scenario):
     """Paper 002's scenario for campaigns (see the module docstring); settings are the Scenario's."""
 
     offers = OFFERS
-
-    def campaign_truth(self, conditions, noise, rngs):
-        """Truth and star-sensor readings of the runs whose generators are ``rngs``.
-
-        Returns
-        -------
-        hinfnav.sim.Truth
-        """
-        model = self.truth_model(**conditions)
-        system, meas, ctrl = model.system, model.measurement, model.controller
-        n1, runs = model.n_steps + 1, len(rngs)
-        _, v = draw_noise(make_noise("gaussian"), make_noise(noise, dt=self.dt) if noise == "colored"
-                          else make_noise(noise), rngs, n1, system.n_noise, meas.n_noise)
-        x = np.empty((runs, n1, system.n))
-        u = np.zeros((runs, n1, system.n_input))
-        x[:, 0] = model.x0
-        t = model.time
-        for k in range(n1):
-            if ctrl is not None:
-                u[:, k] = ctrl(x[:, k])
-            if k < n1 - 1:
-                x[:, k + 1] = system.step(x[:, k], u[:, k], None, t[k])
-        settings = dict(model.settings, noise=noise, runs=runs)
-        return Truth(t=t, x=x, u=u, y=meas.measure(x, v), settings=settings, state=system.state, measurement=meas)
 
     def bound_problem(self, conditions, noise):
         """Ingredients of the posterior CRB on (δθ, δω) (see the module docstring); states as (rotation vector, ω)."""

@@ -33,8 +33,8 @@ import numpy as np
 
 from ...analysis.pcrb import posterior_crb
 from ...analysis.riccati import steady_state_kalman
+from ...campaign.runner import cell_truth
 from ...core.exceptions import InputError
-from ...sim.truth import child_rngs, simulate_truth
 from ...systems.hill import measurement_matrix
 from ..sun2011.scenario import Scenario
 
@@ -85,8 +85,8 @@ def cell_bound(scenario, conditions, noise, windows, quantities, *, runs=20, see
 
     * Sun 2011's chaser: :func:`cell_kalman_limit` (the steady-state Riccati limit of the cell's true model);
     * any other scenario, from its ``bound_problem(conditions, noise)``: the posterior Cramér–Rao bound (:func:`hinfnav.analysis.pcrb.posterior_crb`, Tichavský,
-      Muravchik & Nehorai 1998), its expectations a Monte Carlo mean over ``runs`` truths of the scenario's
-      ``campaign_truth`` (seeded by ``seed``, independent of the cells' draws).
+      Muravchik & Nehorai 1998), its expectations a Monte Carlo mean over ``runs`` truths of the cell
+      (:func:`hinfnav.campaign.runner.cell_truth`, seeded by ``seed``, independent of the cells' draws).
 
     Each value is ``√(mean over the window's samples and the group's components of the bound's diagonal)``:
     the quantity a pooled RMS error is compared with.
@@ -104,11 +104,8 @@ def cell_bound(scenario, conditions, noise, windows, quantities, *, runs=20, see
         value = {"position": lim["pos_m"], "velocity": lim["vel_mps"]}
         return {"kind": "riccati", "windows": {w: {q: value[q] for q in quantities} for w in windows}}
     prob = scenario.bound_problem(conditions, noise)
-    model = scenario.truth_model(**conditions)
-    groups = prob.get("groups") or model.system.state.groups
-    own = getattr(scenario, "campaign_truth", None)
-    truth = (own(conditions, noise, child_rngs(seed, runs)) if own is not None
-             else simulate_truth(model, noise=noise, runs=runs, seed=seed))
+    truth = cell_truth(scenario, conditions, noise, seed=seed, runs=runs)
+    groups = prob.get("groups") or truth.state.groups
     states = prob["states"](truth.x)
     diag = posterior_crb(states, prob["F"], prob["H"], prob["Q"], None, prob["P0"],
                          measurement_information=prob["Lambda"], diagonal_only=True)
