@@ -41,7 +41,12 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
     factory : callable
         Returns an object with ``truth_model(**conditions)`` and ``xhat0``
         (the scenario protocol of :mod:`hinfnav.sim`); called with no
-        argument it gives the paper's scenario.
+        argument it gives the paper's scenario. Optional: ``offers`` (an
+        :class:`~hinfnav.estimators.registry.Offers`: what its estimators may
+        rely on) and ``campaign_truth(conditions, noise, rngs)`` returning a
+        :class:`~hinfnav.sim.truth.Truth` (a truth the simulators cannot make
+        from ``truth_model`` alone: an impulse, another noise per channel; the
+        campaign runner uses it when present, :func:`~hinfnav.campaign.runner.cell_truth`).
     description : str
     """
     if not isinstance(name, str) or not name:
@@ -51,8 +56,17 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
     _SCENARIOS[name] = _ScenarioEntry(name, factory, description)
 
 
+_LOADED = {"providers": False}
+
+
 def registered_scenarios() -> tuple[str, ...]:
-    """Names of the registered scenarios, in registration order."""
+    """Names of the registered scenarios, in registration order.
+
+    The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
+    """
+    if not _LOADED["providers"]:
+        _LOADED["providers"] = True
+        load_providers()
     return tuple(_SCENARIOS)
 
 

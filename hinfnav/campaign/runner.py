@@ -51,7 +51,8 @@ from ..io.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
 from ..metrics.accumulator import StatisticsAccumulator, add_batch
 from ..metrics.consistency import NIS_KEYS, warn_if_diverged
-from ..sim.engine import estimate_on_truth, truth_batches, truth_runs
+from ..sim.engine import estimate_on_truth, truth_batch, truth_batches, truth_runs
+from ..sim.truth import child_rngs
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
 from .table import results_table
@@ -61,7 +62,8 @@ if TYPE_CHECKING:
 
     from .spec import Campaign
 
-__all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "SERIAL"]
+__all__ = ["run_campaign", "read_campaign", "campaign_client", "run_unit", "campaign_units", "clear_cache", "cell_truth",
+           "SERIAL"]
 
 #: ``client=SERIAL`` runs every task in this process, one after another (no cluster; for debugging and tests).
 SERIAL = "serial"
@@ -155,8 +157,8 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
         elapsed[c["cell_id"]] += time.perf_counter() - t0
         cpu[c["cell_id"]] += time.process_time() - c0
     truth_s = truth_cpu = 0.0
-    batches = truth_batches(scenario, unit["conditions"], runs=runs, batch_size=bs, seed=unit["seed"],
-                            noise=unit["noise"])
+    batches = cell_truth_batches(scenario, unit["conditions"], unit["noise"], seed=unit["seed"], runs=runs,
+                                 batch_size=bs)
     while True:  # the engine's open loop, with each cell's failures and time kept apart
         t0, c0 = time.perf_counter(), time.process_time()
         batch = next(batches, None)
@@ -193,6 +195,31 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
             res.update(status="diverged" if blown else "ok", diverged=stats["consistency"]["diverged"], statistics=stats)
         out.append(res)
     return out
+
+
+def cell_truth(scenario, conditions, noise, *, seed, runs, first_run=0):
+    """Runs ``first_run … first_run + runs − 1`` of a cell's truth (:class:`~hinfnav.sim.truth.Truth`).
+
+    The scenario's own ``campaign_truth(conditions, noise, rngs)`` when it has one (an impulse, another noise per
+    channel…; ``rngs`` the runs' child generators of ``seed``, as the simulators draw them); else the engine's
+    :func:`~hinfnav.sim.engine.truth_batch` (the scenario's ``truth_model(**conditions)``, linear or stepping
+    itself). The same seed gives the same runs whatever the batches.
+    """
+    own = getattr(scenario, "campaign_truth", None)
+    if own is not None:
+        return own(conditions, noise, child_rngs(seed, first_run + runs)[first_run:])
+    return truth_batch(scenario, conditions, noise=noise, runs=runs, seed=seed, first_run=first_run)
+
+
+def cell_truth_batches(scenario, conditions, noise, *, seed, runs, batch_size):
+    """``(start, truth)`` of each batch of a cell's runs (:func:`cell_truth`; the engine's batches when the
+    scenario has no ``campaign_truth``)."""
+    if getattr(scenario, "campaign_truth", None) is None:
+        yield from truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed, noise=noise)
+        return
+    for start in range(0, runs, batch_size):
+        yield start, cell_truth(scenario, conditions, noise, seed=seed, runs=min(batch_size, runs - start),
+                                first_run=start)
 
 
 def _run_cell_batch(est, truth, xhat0, acc, start):

@@ -63,7 +63,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.exceptions import InputError
-from ..estimators.registry import estimator_entry, registered_estimators
+from ..estimators.registry import estimator_entry, fit_reason, registered_estimators
 from ..noise import NOISE_NAMES
 from .registry import build_scenario, condition_parameters, scenario_entry, scenario_parameters
 
@@ -324,8 +324,9 @@ class Campaign:
             except InputError:
                 raise InputError(f"grid.estimator: unknown estimator {name!r}; registered: "
                                  f"{', '.join(registered_estimators())}") from None
-            if not entry.fits(scenario):
-                raise InputError(f"grid.estimator: {name!r} does not fit scenario {scenario_name!r}; these do: "
+            why = fit_reason(entry.name, scenario)
+            if why is not None:
+                raise InputError(f"grid.estimator: {name!r} does not fit scenario {scenario_name!r} ({why}); these do: "
                                  f"{', '.join(registered_estimators(scenario))}")
         return names
 

@@ -1,8 +1,12 @@
 """Estimators by name: each paper registers the builders that fit its scenarios.
 
 A builder takes a scenario (and options) and returns an
-:class:`~hinfnav.estimators.base.Estimator`; ``fits(scenario)`` says whether
-the estimator applies to that scenario. The simulation resolves estimator
+:class:`~hinfnav.estimators.base.Estimator`. Whether it applies to a scenario
+is declared on both sides: the estimator's :class:`Requires` (state error
+form, measurement kind, the applied input, linear dynamics, the model it is
+built from) against the scenario's :class:`Offers` (its ``offers``
+attribute); :func:`fit_reason` says why a pair does not fit. A ``fits(scenario)``
+callable is still accepted for scenario objects that declare no offers. The simulation resolves estimator
 names through :func:`build_estimator`; the contract test suite runs over
 :func:`registered_estimators`.
 
@@ -26,7 +30,87 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
-           "providers", "PROVIDER_GROUP"]
+           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS"]
+
+#: State error forms: additive (x − x̂) or multiplicative quaternion (attitude).
+ERROR_FORMS = ("additive", "quaternion")
+
+
+@dataclass(frozen=True)
+class Offers:
+    """What a scenario offers its estimators (its ``offers`` attribute).
+
+    Attributes
+    ----------
+    error_form : {"additive", "quaternion"}
+        How its state error is formed.
+    measurement : str
+        Kind of its readings (``"position"``, ``"range_angle"``, ``"star_vectors"``, ``"saturated_linear"``…).
+    input : bool
+        The applied input (control) is known to the estimators.
+    linear : bool
+        Its dynamics are linear (a LinearSystem), as the LMI designs need.
+    models : tuple of str
+        Models it hands to builders: a paper's key (its own scenario object, e.g. ``"sun2011"``) and/or
+        ``"kalman"`` (a generic ``kalman_model()``: system, measurement, P0, Q, uses_input).
+    """
+
+    error_form: str = "additive"
+    measurement: str = ""
+    input: bool = False
+    linear: bool = False
+    models: tuple = ()
+
+    def __post_init__(self):
+        if self.error_form not in ERROR_FORMS:
+            raise InputError(f"error_form must be one of {', '.join(ERROR_FORMS)}; got {self.error_form!r}")
+        object.__setattr__(self, "models", tuple(self.models))
+
+
+@dataclass(frozen=True)
+class Requires:
+    """What an estimator needs of a scenario (declared at registration; None: anything).
+
+    Attributes
+    ----------
+    error_form : str or None
+    measurement : tuple of str or None
+        Measurement kinds it can use.
+    input : bool
+        Needs the applied input.
+    linear : bool
+        Needs linear dynamics (the LMI designs, the steady-state filters).
+    model : str or None
+        The model it is built from (see :attr:`Offers.models`).
+    """
+
+    error_form: str | None = "additive"
+    measurement: tuple | None = None
+    input: bool = False
+    linear: bool = False
+    model: str | None = None
+
+    def __post_init__(self):
+        if self.error_form is not None and self.error_form not in ERROR_FORMS:
+            raise InputError(f"error_form must be one of {', '.join(ERROR_FORMS)} or None; got {self.error_form!r}")
+        if self.measurement is not None:
+            object.__setattr__(self, "measurement", tuple(self.measurement))
+
+    def reason(self, offers: Offers) -> str | None:
+        """Why a scenario offering ``offers`` does not fit (None: it fits)."""
+        if self.model is not None and self.model not in offers.models:
+            return (f"built from the {self.model!r} model; the scenario offers "
+                    f"{', '.join(map(repr, offers.models)) or 'none'}")
+        if self.error_form is not None and offers.error_form != self.error_form:
+            return f"needs an {self.error_form} state error; the scenario's is {offers.error_form}"
+        if self.measurement is not None and offers.measurement not in self.measurement:
+            return (f"uses {' or '.join(self.measurement)} readings; the scenario has {offers.measurement or 'other'} "
+                    "readings")
+        if self.input and not offers.input:
+            return "needs the applied input; the scenario does not give it"
+        if self.linear and not offers.linear:
+            return "needs linear dynamics (an LMI design or a Riccati equation); the scenario's are nonlinear"
+        return None
 
 
 @dataclass(frozen=True)
@@ -35,6 +119,7 @@ class _Entry:
     builder: object
     fits: object
     description: str
+    requires: Requires | None = None
 
 
 _REGISTRY = {}
@@ -70,7 +155,7 @@ def _ensure_providers():
 
 
 def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Callable[[Any], bool] | None = None,
-                       description: str = "") -> None:
+                       description: str = "", requires: Requires | None = None) -> None:
     """Register ``builder(scenario, **options) -> Estimator`` under ``name``.
 
     Parameters
@@ -78,8 +163,11 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     name : str
     builder : callable
     fits : callable, optional
-        ``fits(scenario) -> bool``; default: fits every scenario.
+        ``fits(scenario) -> bool``, for scenarios that declare no :class:`Offers`
+        (and checked too on those that do); default: fits every scenario.
     description : str
+    requires : Requires, optional
+        What the estimator needs, checked against a scenario's ``offers`` (:func:`fit_reason`).
     """
     if not isinstance(name, str) or not name:
         raise InputError(f"estimator name must be a non-empty string; got {name!r}")
@@ -87,7 +175,26 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
         raise InputError(f"builder must be callable as builder(scenario, **options); got {type(builder).__name__}")
     if fits is not None and not callable(fits):
         raise InputError(f"fits must be callable as fits(scenario) -> bool; got {type(fits).__name__}")
-    _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description)
+    if requires is not None and not isinstance(requires, Requires):
+        raise InputError(f"requires must be a hinfnav Requires; got {type(requires).__name__}")
+    _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description, requires)
+
+
+def fit_reason(name: str, scenario: Any) -> str | None:
+    """Why the estimator ``name`` does not fit ``scenario`` (None: it fits).
+
+    A scenario with ``offers`` (:class:`Offers`) is checked against the
+    estimator's :class:`Requires` first; then the estimator's ``fits`` callable.
+    """
+    entry = estimator_entry(name)
+    offers = getattr(scenario, "offers", None)
+    if isinstance(offers, Offers) and entry.requires is not None:
+        why = entry.requires.reason(offers)
+        if why is not None:
+            return why
+    if not entry.fits(scenario):
+        return f"its builder does not take a {type(scenario).__name__} (fits() is False)"
+    return None
 
 
 def registered_estimators(scenario: Any = None) -> tuple[str, ...]:
@@ -96,7 +203,7 @@ def registered_estimators(scenario: Any = None) -> tuple[str, ...]:
     The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
     """
     _ensure_providers()
-    return tuple(n for n, e in _REGISTRY.items() if scenario is None or e.fits(scenario))
+    return tuple(n for n in tuple(_REGISTRY) if scenario is None or fit_reason(n, scenario) is None)
 
 
 def estimator_entry(name: str) -> _Entry:
@@ -111,7 +218,9 @@ def estimator_entry(name: str) -> _Entry:
 def build_estimator(name: str, scenario: Any, **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``."""
     entry = estimator_entry(name)
-    if not entry.fits(scenario):
+    why = fit_reason(name, scenario)
+    if why is not None:
         fitting = ", ".join(registered_estimators(scenario))
-        raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}); these do: {fitting}")
+        raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "
+                         f"these do: {fitting}")
     return entry.builder(scenario, **options)

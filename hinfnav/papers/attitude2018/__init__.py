@@ -7,6 +7,7 @@ scenario (:mod:`.scenario`), registered filters (:mod:`.filters`), studies
 transfer of its ideas to Sun 2011's chaser (:mod:`.chaser`) and ``reproduce``.
 """
 
+from .campaign import CampaignScenario
 from .chaser import (
     ChaserStudy,
     build_augmented_thrust,
@@ -45,6 +46,7 @@ from .studies import (
 )
 
 __all__ = [
+    "CampaignScenario",
     "ATTITUDE_FILTERS",
     "CHASER_FILTERS",
     "CITATION",

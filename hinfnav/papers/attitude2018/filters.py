@@ -22,7 +22,7 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ...estimators.attitude import AttitudeAAEKF, AttitudeAEKF, AttitudeASTEKF
-from ...estimators.registry import register_estimator
+from ...estimators.registry import Requires, register_estimator
 from ..sun2011.scenario import Scenario as ChaserScenario
 from .chaser import build_augmented_thrust
 from .constants import DEFAULT_AA, DEFAULT_ST, PAPER_Q_ASTEKF, PAPER_Q_BEST_AEKF
@@ -118,6 +118,8 @@ def _chaser_builder(variant):
 
 
 for _name in ATTITUDE_FILTERS:
-    register_estimator(_name, _BUILDERS[_name], fits=_attitude_fits, description=_DESCRIPTIONS[_name])
+    register_estimator(_name, _BUILDERS[_name], fits=_attitude_fits, description=_DESCRIPTIONS[_name],
+                       requires=Requires(error_form="quaternion", measurement=("star_vectors",), input=True, model="attitude2018"))
 for _name, _variant in zip(CHASER_FILTERS, ("plain", "st", "adaptive")):
-    register_estimator(_name, _chaser_builder(_variant), fits=_chaser_fits, description=_DESCRIPTIONS[_name])
+    register_estimator(_name, _chaser_builder(_variant), fits=_chaser_fits, description=_DESCRIPTIONS[_name],
+                       requires=Requires(model="sun2011", linear=True))

@@ -1,6 +1,11 @@
 """The cross-paper benchmark's grid: which estimators, which cells, and which estimator/scenario pairs do not fit.
 
-The table is filled on Sun et al. (2011)'s chaser: every registered estimator
+The benchmark runs one campaign per registered scenario (:data:`SCENARIOS`,
+:func:`scenario_campaign`): every registered estimator that fits it (by the
+declared requirements, :func:`hinfnav.estimators.registry.fit_reason`), the
+others listed with their reason (:func:`non_fitting`, :func:`fit_matrix`).
+
+:func:`benchmark_campaign` is the larger grid of issue 13 on Sun et al. (2011)'s chaser: every registered estimator
 that fits it (:func:`hinfnav.estimators.registered_estimators`), with and
 without maneuver, δ ∈ {0, 1, 5}, noise ∈ {gaussian, mixture (paper 001's,
 ε = 0.6, σ₂ = 2σ₁), student_t, colored}, ``runs`` ≥ 200 per cell, RMS over
@@ -15,12 +20,14 @@ benchmark without a change here.
 
 import importlib
 
+from ...campaign.registry import build_scenario, registered_scenarios, scenario_parameters
 from ...campaign.spec import Campaign
-from ...estimators.registry import estimator_entry, registered_estimators
+from ...core.exceptions import InputError
+from ...estimators.registry import estimator_entry, fit_reason, registered_estimators
 from ..sun2011.scenario import Scenario
 
 __all__ = ["PAPER_MODULES", "load_papers", "benchmark_campaign", "fit_matrix", "WINDOWS", "NOISES", "DELTAS",
-           "TOL"]
+           "TOL", "SCENARIOS", "scenario_campaign", "non_fitting"]
 
 #: Every paper package, in the order of their decades.
 PAPER_MODULES = ("sun2011", "shi2018", "attitude2018", "yang2020")
@@ -82,58 +89,64 @@ def benchmark_campaign(*, runs=200, seed=0, estimators=None, batch_size=200, man
                           "delta": list(deltas), "noise": list(noises)})
 
 
-#: Why an estimator does not fit another paper's scenario, by the estimator's family (name prefix or name).
-_WHY_NOT = {
-    "sun2011": "built from Sun 2011's chaser: its 6-state Hill model with the feedback gain K at T = 0.1 s and the "
-               "Cartesian position measurement (8); the other scenarios have another state (attitude, drag-free "
-               "axes), another T (Shi 2018: 0.4 s) or range/angle readings, and no law u = K x",
-    "ekf_converted": "Shi 2018's EKF on the position converted from range, azimuth and elevation (R_k = J R Jᵀ); "
-                     "the chaser of Sun 2011 measures Cartesian position directly, where it would be ekf_known_input",
-    "attitude": "paper 002's gyroless attitude filters: quaternion, rate and torque states with star-sensor "
-                "readings; no translational scenario has them (their idea on the chaser is the "
-                "ekf_augmented_thrust family)",
-    "augmented_thrust": "paper 002's idea moved to Sun 2011's chaser (the unknown thrust as random-walk state); "
-                        "registered for that chaser only",
-    "yang2020": "Yang 2020's extended-state filters of a drag-free satellite (accelerometer with saturation, "
-                "lumped disturbance states, ADRC loop); no other scenario has those states or readings",
-    "hbf": "the Huber update needs a registered Kalman filter of the scenario to robustify (or a scenario with "
-           "truth_model, xhat0 and P0); this scenario offers neither",
-    "ukf": "the sigma-point filter is built as the unscented version of a registered Kalman filter of the scenario "
-           "(Sun 2011's ekf_known_input, Shi 2018's EKF); this scenario has none registered",
-    "kalman_variant": "strong tracking (and Huber x strong tracking) is built on a registered Kalman filter of the "
-                      "scenario (Sun 2011's ekf_known_input, Shi 2018's EKF); this scenario has none registered",
+#: The benchmark's grid per scenario: ``grid`` (conditions, settings and noises), ``windows`` (name → (start, end),
+#: s; ``steady`` is the table's), ``quantities`` (the two state groups of the table), ``tol`` (convergence
+#: tolerance per component, or None). Sized so that the whole benchmark takes at most 5 minutes on 2 cores
+#: (measured in the README); the scenarios' own defaults are the papers' (longer runs).
+SCENARIOS = {
+    "sun2011": {"grid": {"maneuver": [True, False], "delta": [0.0, 5.0], "noise": ["gaussian", "mixture"]},
+                "windows": {"early": (0.0, 500.0), "steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"),
+                "tol": TOL},
+    "shi2018": {"grid": {"maneuver": [True, False], "noise": ["gaussian", "mixture"]},
+                "windows": {"steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"), "tol": None},
+    "attitude2018": {"grid": {"orbits": [0.5], "T0": [1e-5, 1e-4], "noise": ["gaussian"]},
+                     "windows": {"steady": (1450.0, 2900.0)}, "quantities": ("attitude", "rate"), "tol": None},
+    "yang2020": {"grid": {"n_steps": [10_000], "disturbance": [-3e-3, -12.8e-3], "noise": ["gaussian"]},
+                 "windows": {"steady": (500.0, 1000.0)}, "quantities": ("displacement", "velocity"), "tol": None},
 }
 
 
-def _family(name):
-    if name in ("aekf", "astekf", "aaekf"):
-        return "attitude"
-    if name.startswith("ekf_augmented_thrust"):
-        return "augmented_thrust"
-    if name.startswith("yang2020"):
-        return "yang2020"
-    if name in ("hbf", "ekf_converted", "ukf"):
-        return name
-    if name in ("stekf", "huber_stekf"):
-        return "kalman_variant"
-    return "sun2011"
+def scenario_campaign(key, *, runs=50, seed=0, estimators=None, batch_size=50, grid=None):
+    """The benchmark's campaign on one scenario: every fitting estimator on the scenario's grid (:data:`SCENARIOS`).
+
+    Parameters
+    ----------
+    key : str
+        A key of :data:`SCENARIOS` (a registered scenario).
+    runs, seed, batch_size : int
+    estimators : sequence of str, optional
+        Default: every registered estimator that fits the scenario (its first settings).
+    grid : dict, optional
+        Replaces entries of the scenario's grid (a smaller one for a quick look).
+
+    Returns
+    -------
+    Campaign
+    """
+    if key not in SCENARIOS:
+        raise InputError(f"scenario: the benchmark has no scenario {key!r}; choose from {', '.join(SCENARIOS)}")
+    spec = SCENARIOS[key]
+    g = {**spec["grid"], **(grid or {})}
+    if estimators is None:
+        settings = {k: v[0] for k, v in g.items() if k in scenario_parameters(key)}
+        estimators = registered_estimators(build_scenario(key, **settings))
+    return Campaign(name=f"benchmark_{key}", runs=runs, seed=seed, batch_size=batch_size, windows=spec["windows"],
+                    tol=spec["tol"], grid={"scenario": key, "estimator": list(estimators), **g})
 
 
-def _scenarios(papers):
+def non_fitting(key, settings=None):
+    """Every registered estimator that does not fit scenario ``key`` (with ``settings``), with the reason."""
+    sc = build_scenario(key, **(settings or {}))
     out = {}
-    for key in PAPER_MODULES:
-        if papers.get(key) is not None:
-            continue
-        try:
-            module = importlib.import_module(f"{__package__.rsplit('.', 1)[0]}.{key}")
-            out[key] = module.Scenario()
-        except Exception:
-            continue
+    for name in registered_estimators():
+        why = fit_reason(name, sc)
+        if why is not None:
+            out[name] = why
     return out
 
 
 def fit_matrix(papers=None):
-    """Which registered estimator fits which paper's scenario, and why not where it does not.
+    """Which registered estimator fits which registered scenario, and why not where it does not.
 
     Parameters
     ----------
@@ -144,19 +157,13 @@ def fit_matrix(papers=None):
     -------
     dict
         ``{"scenarios": [...], "estimators": {name: {"description", "fits": {scenario: bool},
-        "why_not": {scenario: reason}}}}``.
+        "why_not": {scenario: reason}}}}`` (reasons from :func:`hinfnav.estimators.registry.fit_reason`).
     """
     papers = load_papers() if papers is None else papers
-    scenarios = _scenarios(papers)
+    scenarios = {key: build_scenario(key) for key in registered_scenarios()}
     out = {}
     for name in registered_estimators():
-        entry = estimator_entry(name)
-        fits = {}
-        for key, sc in scenarios.items():
-            try:
-                fits[key] = bool(entry.fits(sc))
-            except Exception:
-                fits[key] = False
-        why = {key: _WHY_NOT[_family(name)] for key, ok in fits.items() if not ok}
-        out[name] = {"description": entry.description, "fits": fits, "why_not": why}
+        why = {key: fit_reason(name, sc) for key, sc in scenarios.items()}
+        out[name] = {"description": estimator_entry(name).description, "fits": {k: w is None for k, w in why.items()},
+                     "why_not": {k: w for k, w in why.items() if w is not None}}
     return {"scenarios": list(scenarios), "estimators": out}

@@ -1,4 +1,6 @@
-"""The Kalman limit of one benchmark cell: the Riccati limit of that cell's true model.
+"""The bound of one benchmark cell: the Riccati limit of a linear-Gaussian cell, the posterior CRB of the others.
+
+:func:`cell_bound` gives every cell its bound (below, the Riccati limit of Sun 2011's cells).
 
 For Sun et al. (2011)'s chaser with the true orbital-rate error δ the truth
 is ``x(k+1) = A x(k) + B w(k)``, ``y(k) = C x(k) + D v(k)`` with
@@ -29,12 +31,14 @@ What the limit does and does not bound (said beside the table):
 
 import numpy as np
 
+from ...analysis.pcrb import posterior_crb
 from ...analysis.riccati import steady_state_kalman
+from ...campaign.runner import cell_truth
 from ...core.exceptions import InputError
 from ...systems.hill import measurement_matrix
 from ..sun2011.scenario import Scenario
 
-__all__ = ["cell_kalman_limit"]
+__all__ = ["cell_kalman_limit", "cell_bound"]
 
 
 def cell_kalman_limit(scenario, *, maneuver, delta=0.0, discretization="exact"):
@@ -68,3 +72,45 @@ def cell_kalman_limit(scenario, *, maneuver, delta=0.0, discretization="exact"):
     rms = lambda s: float(np.sqrt(np.mean(s ** 2)))
     return {"pos_m": rms(sf[:3]), "vel_mps": rms(sf[3:]), "pos_m_predicted": rms(sp[:3]),
             "vel_mps_predicted": rms(sp[3:]), "pos_axes_m": sf[:3].tolist(), "vel_axes_mps": sf[3:].tolist()}
+
+
+def _group_rms(diag, groups, quantities, mask=None):
+    """RMS over a group's components (and the masked steps) of a bound's diagonal ``(…, n)``."""
+    d = diag if mask is None else diag[mask]
+    return {q: float(np.sqrt(np.mean(d[..., list(groups[q])]))) for q in quantities}
+
+
+def cell_bound(scenario, conditions, noise, windows, quantities, *, runs=20, seed=0):
+    """The bound of one benchmark cell, per window and quantity: the RMS error no estimator can beat.
+
+    * Sun 2011's chaser: :func:`cell_kalman_limit` (the steady-state Riccati limit of the cell's true model);
+    * any other scenario, from its ``bound_problem(conditions, noise)``: the posterior Cramér–Rao bound (:func:`hinfnav.analysis.pcrb.posterior_crb`, Tichavský,
+      Muravchik & Nehorai 1998), its expectations a Monte Carlo mean over ``runs`` truths of the cell
+      (:func:`hinfnav.campaign.runner.cell_truth`, seeded by ``seed``, independent of the cells' draws).
+
+    Each value is ``√(mean over the window's samples and the group's components of the bound's diagonal)``:
+    the quantity a pooled RMS error is compared with.
+
+    Returns
+    -------
+    dict
+        ``{"kind": "riccati" | "pcrb", "windows": {window: {quantity: bound}}}``. With linear dynamics and
+        measurements the posterior CRB is the Kalman covariance recursion (from the bound's P₀), the same on
+        every run (tested equal to the Riccati limit once converged).
+    """
+    if isinstance(scenario, Scenario):
+        lim = cell_kalman_limit(scenario, maneuver=bool(conditions.get("maneuver", False)),
+                                delta=float(conditions.get("delta", 0.0)))
+        value = {"position": lim["pos_m"], "velocity": lim["vel_mps"]}
+        return {"kind": "riccati", "windows": {w: {q: value[q] for q in quantities} for w in windows}}
+    prob = scenario.bound_problem(conditions, noise)
+    truth = cell_truth(scenario, conditions, noise, seed=seed, runs=runs)
+    groups = prob.get("groups") or truth.state.groups
+    states = prob["states"](truth.x)
+    diag = posterior_crb(states, prob["F"], prob["H"], prob["Q"], None, prob["P0"],
+                         measurement_information=prob["Lambda"], diagonal_only=True)
+    out = {}
+    for w, (a, b) in windows.items():
+        mask = (truth.t >= a - 1e-9) & (truth.t <= b + 1e-9)
+        out[w] = _group_rms(diag, groups, quantities, mask)
+    return {"kind": "pcrb", "windows": out}

@@ -1,98 +1,162 @@
-"""``python -m hinfnav reproduce --paper benchmark``: the cross-paper table on Sun 2011's chaser, as a Dask campaign."""
+"""``python -m hinfnav reproduce --paper benchmark``: every fitting estimator on every registered scenario, as Dask campaigns."""
 
 from pathlib import Path
 
-from ...campaign.runner import run_campaign
+import time
+
+import pandas as pd
+
+from ...campaign.registry import build_scenario, scenario_parameters
+from ...campaign.runner import campaign_client, run_campaign
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from ..skeleton import Reproduction, atomic_write_text
-from .grid import DELTAS, NOISES, TOL, WINDOWS, benchmark_campaign, fit_matrix, load_papers
-from .table import benchmark_table, best_by_condition, format_markdown, plot_heatmap
+from .cross import WINDOW, cross_table, plot_scenario_heatmap, winners
+from .grid import SCENARIOS, load_papers, non_fitting, scenario_campaign
+from .limits import cell_bound
 
-__all__ = ["NOTEBOOKS", "reproduce"]
+__all__ = ["NOTEBOOKS", "reproduce", "BENCHMARK_RUNS", "BOUND_RUNS"]
 
 #: The comparison chapter of the workbook (``reproduce(notebooks=True)``).
 NOTEBOOKS = ("90_cross_paper_benchmark.ipynb",)
 
-#: Fewer runs than this is a quick look, not the benchmark (said in the summary).
-BENCHMARK_RUNS = 200
+#: Monte Carlo runs per cell of the benchmark (fewer: a quick look, said in the summary). 50 keeps the whole
+#: benchmark within 5 minutes on 2 cores (README); the 95 % intervals of the ratios are then a few per cent wide.
+BENCHMARK_RUNS = 50
+#: Truth runs of the Monte Carlo mean in a posterior CRB (independent of the cells' draws).
+BOUND_RUNS = 20
 
 
-def _note(runs):
-    parts = [f"{runs} Monte Carlo runs per cell (seeds from the cell, common to every estimator of a cell)."]
-    if runs < BENCHMARK_RUNS:
-        parts.append(f"**Quick look**: the benchmark proper has at least {BENCHMARK_RUNS} runs per cell.")
-    return " ".join(parts)
+def _markdown(table, best, note):
+    lines = ["# Cross-paper benchmark", "", note, "",
+             "Each entry: RMS error (pooled over runs, samples of the steady window and the group's components) "
+             "divided by the cell's bound — the Riccati limit of a linear-Gaussian cell, the posterior Cramér–Rao "
+             "bound of the others — with its 95 % interval. 1: at the bound. NEES, NIS and absolute errors are in "
+             "`table.csv` and `summary.json`.", ""]
+    for sc, sub in table.groupby("scenario", sort=False):
+        for q, part in sub.groupby("quantity", sort=False):
+            conds = list(dict.fromkeys(part["condition"]))
+            lines += [f"## {sc}: {q} ({part['unit'].iloc[0]}), bound: {part['bound_kind'].iloc[0]}", "",
+                      "| estimator | " + " | ".join(conds) + " |", "|---|" + "---|" * len(conds)]
+            for est, rows in part.groupby("estimator", sort=False):
+                by = {r.condition: r for r in rows.itertuples()}
+                cells = [f"{by[c].ratio:.3g} [{by[c].ratio_low:.3g}, {by[c].ratio_high:.3g}]" if c in by else "—"
+                         for c in conds]
+                lines.append(f"| `{est}` | " + " | ".join(cells) + " |")
+            lines.append("")
+    lines += ["## Which estimator wins where", "", "| scenario | condition | quantity | best (ratio) | runner-up (ratio) "
+              "| intervals separate |", "|---|---|---|---|---|---|"]
+    for b in best:
+        lines.append(f"| {b['scenario']} | {b['condition']} | {b['quantity']} | `{b['best']}` ({b['ratio']:.3g}) | "
+                     f"`{b['runner_up']}` ({b['runner_up_ratio']:.3g}) | {b['separated']} |")
+    return "\n".join(lines) + "\n"
 
 
 def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, notebooks=False, progress=True,
-              client=None, campaign_dir=None, estimators=None):
-    """Run the cross-paper benchmark and write its table, heat map and summary into ``out_dir``.
+              client=None, campaign_dir=None, scenarios=None, grids=None, estimators=None, bound_runs=BOUND_RUNS,
+              workers=None):
+    """Run the cross-paper benchmark and write its tables, heat maps and summary into ``out_dir``.
 
     Parameters
     ----------
     out_dir : str or Path
     seed : int
     runs : int
-        Monte Carlo runs per cell (the benchmark: ≥ 200).
+        Monte Carlo runs per cell.
     notebooks : bool
         Also execute :data:`NOTEBOOKS` into ``out_dir``.
     progress : bool
     client : None, "serial", str or distributed.Client
-        Where the campaign runs (:func:`hinfnav.run_campaign`); default a LocalCluster on this machine's cores.
+        Where the campaigns run (:func:`hinfnav.run_campaign`); default one LocalCluster for all of them.
     campaign_dir : str or Path, optional
-        Keep the campaign's cells there (resumable across calls); default ``out_dir/campaign``.
-    estimators : sequence of str, optional
-        Default: every registered estimator that fits the chaser.
+        Keep the campaigns' cells there (resumable); default ``out_dir/campaign``.
+    scenarios : sequence of str, optional
+        Default: every scenario of :data:`~.grid.SCENARIOS`.
+    grids : dict, optional
+        Scenario → grid entries replacing the benchmark's (a smaller grid for a quick look).
+    estimators : dict, optional
+        Scenario → estimator names (default: every registered estimator that fits it).
+    bound_runs : int
+        Truth runs of each posterior CRB.
+    workers : int, optional
+        Worker processes of the LocalCluster (default one per core).
 
     Returns
     -------
     dict
-        The summary written to ``summary.json``: ``cells`` (one object per cell with its parameters and
-        statistics), ``estimators`` (the list run), ``kalman_limits``, ``best``, ``fit_matrix``,
-        ``papers`` (which imported), ``elapsed_s`` and ``provenance``.
+        The summary written to ``summary.json``: ``scenarios``, ``estimators`` (per scenario), ``cells`` (scenario,
+        estimator, conditions, noise, quantity, RMS, bound, ratio, interval, NEES…), ``non_fitting`` (scenario →
+        estimator → reason), ``best`` (which estimator wins where), ``errors``, ``cpu_s`` (the cells', in the
+        workers), ``main_cpu_s`` (this process: bounds, tables, figures), ``elapsed_s``, ``provenance``.
     """
     runs = as_int_at_least("runs", runs, 1)
-    rep = Reproduction(out_dir, "benchmark", notebooks=NOTEBOOKS if notebooks else (),
-                       progress=progress, seed=seed, runs=runs)
+    bound_runs = as_int_at_least("bound_runs", bound_runs, 1)
+    keys = list(SCENARIOS) if scenarios is None else list(scenarios)
+    for key in keys:
+        if key not in SCENARIOS:
+            raise InputError(f"scenarios: the benchmark has no scenario {key!r}; choose from {', '.join(SCENARIOS)}")
+    rep = Reproduction(out_dir, "benchmark", notebooks=NOTEBOOKS if notebooks else (), progress=progress, seed=seed,
+                       runs=runs)
     out = rep.out
+    c0 = time.process_time()
     papers = load_papers()
     for key, err in papers.items():
         if err is not None:
-            rep.say(f"paper {key} could not be imported, its estimators are left out: {err}")
-    campaign = benchmark_campaign(runs=runs, seed=seed, estimators=estimators)
+            rep.say(f"paper {key} could not be imported, its scenario and estimators are left out: {err}")
     cdir = Path(campaign_dir) if campaign_dir is not None else out / "campaign"
-    results = run_campaign(campaign, client=client, out_dir=cdir / campaign.name, progress=progress)
-    errors = dict(results.attrs["errors"])
-    table = benchmark_table(results)
-    names = list(dict.fromkeys(table["estimator"]))
-    note = _note(runs)
-    table.to_csv(out / "table.csv", index=False)
-    atomic_write_text(out / "table.md", format_markdown(table, note=note))
-    rep.save_figure(plot_heatmap(table), "heatmap")
-    cells = [{**c["params"], "cell_id": c["cell_id"], "seed": c["seed"], "runs": c["runs"], "status": c["status"],
-              "statistics": c["statistics"], "timing": c["timing"]} for c in results.attrs["cells"]]
-    ratios = table.to_dict(orient="records")
-    limits = {f"maneuver={m} delta={d:g}": {"pos_m": p, "vel_mps": v, "pos_m_predicted": pp, "vel_mps_predicted": vp}
-              for m, d, p, v, pp, vp in table[["maneuver", "delta", "kalman_pos_m", "kalman_vel_mps",
-                                               "kalman_pos_m_predicted", "kalman_vel_mps_predicted"]]
-              .drop_duplicates(["maneuver", "delta"]).itertuples(index=False)}
+    chosen = dict(estimators or {})
+    tables, errors, estimators, unfit, cpu = [], {}, {}, {}, 0.0
+    with campaign_client(client, workers=workers) as dask_client:
+        for key in keys:
+            campaign = scenario_campaign(key, runs=runs, seed=seed, grid=(grids or {}).get(key),
+                                         estimators=chosen.get(key))
+            settings = {k: v[0] for k, v in campaign.grid.items() if k in scenario_parameters(key)}
+            estimators[key] = list(campaign.grid["estimator"])
+            unfit[key] = non_fitting(key, settings)
+            results = run_campaign(campaign, client=dask_client, out_dir=cdir / campaign.name, progress=progress)
+            errors.update(results.attrs["errors"])
+            spec = SCENARIOS[key]
+            scenarios_built, bounds = {}, {}
+
+            def bound_of(params, noise, key=key, spec=spec, scenarios_built=scenarios_built, bounds=bounds):
+                sets = {k: v for k, v in params.items() if k in scenario_parameters(key)}
+                conds = {k: v for k, v in params.items() if k not in sets}
+                skey = repr(sorted(sets.items()))
+                if skey not in scenarios_built:
+                    scenarios_built[skey] = build_scenario(key, **sets)
+                bkey = (skey, repr(sorted(conds.items())), noise)
+                if bkey not in bounds:
+                    bounds[bkey] = cell_bound(scenarios_built[skey], conds, noise, spec["windows"],
+                                              spec["quantities"], runs=bound_runs, seed=seed)
+                return bounds[bkey]
+
+            cells = results.attrs["cells"]
+            cpu += sum(c["timing"]["estimator_cpu_s"] + c["timing"]["truth_cpu_s"] / c["timing"]["unit_cells"]
+                       for c in cells)
+            tables.append(cross_table(cells, key, spec["quantities"], bound_of))
+    table = pd.concat(tables, ignore_index=True)
+    best = winners(table)
+    note = (f"{runs} Monte Carlo runs per cell (seeds from the cell, common to every estimator of a grid point); "
+            f"ratios over the `{WINDOW}` window of each scenario.")
+    table.drop(columns="conditions").to_csv(out / "table.csv", index=False)
+    atomic_write_text(out / "table.md", _markdown(table, best, note))
+    for key in dict.fromkeys(table["scenario"]):
+        rep.save_figure(plot_scenario_heatmap(table, key), f"heatmap_{key}")
     elapsed = rep.elapsed_s
     summary = {
-        "title": "Cross-paper benchmark on Sun et al. (2011)'s chaser (issue 13)",
+        "title": "Cross-paper benchmark: every fitting estimator on every registered scenario (issue 18)",
         "note": note,
-        "grid": {"maneuver": [True, False], "delta": list(DELTAS), "noise": list(NOISES), "windows_s": WINDOWS,
-                 "tol": list(TOL)},
-        "estimators": names,
-        "cells": cells,
-        "table": ratios,
-        "kalman_limits": limits,
-        "best": best_by_condition(table),
-        "fit_matrix": fit_matrix(papers),
+        "scenarios": keys,
+        "grids": {k: {**SCENARIOS[k]["grid"], **(grids or {}).get(k, {})} for k in keys},
+        "windows_s": {k: SCENARIOS[k]["windows"][WINDOW] for k in keys},
+        "estimators": estimators,
+        "cells": table.to_dict(orient="records"),
+        "non_fitting": unfit,
+        "best": best,
         "papers": papers,
         "errors": errors,
-        "cpu_s": sum(c["timing"]["estimator_cpu_s"] + c["timing"]["truth_cpu_s"] / c["timing"]["unit_cells"]
-                     for c in cells),
+        "cpu_s": cpu,
+        "main_cpu_s": time.process_time() - c0,
         "elapsed_s": elapsed,
     }
     summary = rep.write_summary(summary)
@@ -101,5 +165,5 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     if notebooks:
         rep.run_notebooks()
     if progress:
-        print(f"\nbenchmark: {len(cells)} cells, {len(names)} estimators, {elapsed:.0f} s; table in {out / 'table.md'}")
+        print(f"\nbenchmark: {len(table)} rows on {len(keys)} scenarios, {elapsed:.0f} s; table in {out / 'table.md'}")
     return summary

@@ -12,6 +12,7 @@ and the Kalman limit (:mod:`.calibration`), Huber's M-estimation step by step
 (:mod:`.table`), figures (:mod:`.figures`) and ``reproduce``.
 """
 
+from .campaign import CampaignScenario
 from .calibration import RiccatiAccuracy, calibrate_sensor_errors, riccati_accuracy
 from .constants import (
     CALIBRATED_SENSOR_ERRORS,
@@ -41,6 +42,7 @@ from .sweeps import MISTUNING_FACTORS, SENSOR_VARIANTS, mistuning_sweep, sensiti
 from .table import format_table, table_rows, write_table
 
 __all__ = [
+    "CampaignScenario",
     "CITATION",
     "PAPER_RESULTS",
     "PAPER_CLAIMS",

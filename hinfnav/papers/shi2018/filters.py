@@ -30,7 +30,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_positive
 from ...estimators.huber_filter import HuberFilter, HuberStrongTrackingEKF
 from ...estimators.kalman import ExtendedKalmanFilter, StrongTrackingEKF
-from ...estimators.registry import build_estimator, estimator_entry, register_estimator, registered_estimators
+from ...estimators.registry import Requires, build_estimator, estimator_entry, register_estimator, registered_estimators
 from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
@@ -222,13 +222,14 @@ def _build_ekf(scenario, **options):
     return EKF(scenario, **options)
 
 
-register_estimator("hbf", build_hbf, fits=_fits_hbf,
+register_estimator("hbf", build_hbf, fits=_fits_hbf, requires=Requires(error_form="additive"),
                    description="Huber-based filter (Karlgaard & Schaub 2007; Shi & Wang 2018): the scenario's Kalman "
                                "filter with Huber's M-estimation as its update")
-register_estimator("ukf", build_ukf, fits=_fits_ukf,
+register_estimator("ukf", build_ukf, fits=_fits_ukf, requires=Requires(error_form="additive"),
                    description="unscented (sigma-point) Kalman filter, the alternative to the EKF that Sun 2011 and "
                                "Shi & Wang 2018 name: the scenario's Kalman filter with the unscented transform")
 register_estimator("ekf_converted", _build_ekf, fits=lambda scenario: isinstance(scenario, Scenario),
+                   requires=Requires(model="shi2018", measurement=("range_angle",), input=True),
                    description="EKF on the converted (indirect) position measurement, R_k = J R J^T "
                                "(Shi & Wang 2018's comparison)")
 register_estimator("stekf", build_stekf, fits=_fits_ukf,

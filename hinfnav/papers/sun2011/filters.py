@@ -29,7 +29,7 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
-from ...estimators.registry import register_estimator
+from ...estimators.registry import Requires, register_estimator
 from .arguments import scenario_first
 from .constants import published_filter
 from .designs import design_for_scenario
@@ -160,4 +160,6 @@ def _fits(scenario):
 
 
 for _name in FILTER_NAMES:
-    register_estimator(_name, BUILDERS[_name], fits=_fits, description=_DESCRIPTIONS[_name])
+    register_estimator(_name, BUILDERS[_name], fits=_fits, description=_DESCRIPTIONS[_name],
+                       requires=Requires(model="sun2011", linear=not _name.startswith("ekf"),
+                                         input=_name in ("ekf_known_input", "published", "designed", "designed_observer")))

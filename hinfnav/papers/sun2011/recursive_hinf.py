@@ -27,7 +27,7 @@ from ...analysis.hinf_riccati import max_admissible_theta, steady_state_hinf
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_nonnegative, as_positive
 from ...estimators.recursive_hinf import RecursiveHInfinityFilter
-from ...estimators.registry import register_estimator
+from ...estimators.registry import Requires, register_estimator
 from ...metrics.errors import axes_rms, rms_error
 from ...sim.montecarlo import run_estimator
 from ...sim.truth import simulate_truth
@@ -208,6 +208,6 @@ def _build(scenario, **options):
     return build_recursive_hinf(scenario, **options)
 
 
-register_estimator("recursive_hinf", _build, fits=_fits,
+register_estimator("recursive_hinf", _build, fits=_fits, requires=Requires(model="sun2011", linear=True, input=True),
                    description="Simon's recursive (game-theoretic) H-inf filter, a-priori form, told the thrust "
                                "(theta = theta_max/2 by default)")

@@ -22,6 +22,7 @@ from ...core.linalg import discretize, spectral_radius
 from ...core.validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real, as_vector
 from ...design.result import SynthesisResult
 from ...estimators.lti import LTIFilter
+from ...estimators.registry import Offers
 from ...sim.scenario import Scenario as BaseScenario
 from ...sim.truth import TruthModel
 from ...systems.hill import (
@@ -87,6 +88,9 @@ class Scenario(BaseScenario):
     """
 
     omega0: float = 7.2722e-5
+    #: What it offers the estimators (issue 18: fitting by declared requirements); a class attribute, not a setting.
+    offers = Offers(error_form="additive", measurement="position", input=True, linear=True, models=("sun2011",))
+
     mass: float = 1000.0
     dt: float = 0.1
     K: np.ndarray = field(default_factory=lambda: PAPER_K.copy())

@@ -9,6 +9,7 @@ Algorithms 1-3 of :mod:`hinfnav.estimators.extended_state`), the closed loop
 (:mod:`.claims`), Figs 5-12 (:mod:`.figures`) and ``reproduce``.
 """
 
+from .campaign import CampaignScenario
 from .claims import evaluate_claims, format_claims
 from .constants import CITATION, READING_REASONS, READINGS, REQUIREMENT_ASD, TABLE2
 from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12, plot_asd, plot_series, plot_truncated_update
@@ -42,6 +43,7 @@ from .studies import (
 )
 
 __all__ = [
+    "CampaignScenario",
     "CITATION",
     "TABLE2",
     "READINGS",

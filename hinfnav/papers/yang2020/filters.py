@@ -19,7 +19,7 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...estimators.extended_state import ExtendedStateKalmanFilter
 from ...estimators.saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
-from ...estimators.registry import register_estimator
+from ...estimators.registry import Requires, register_estimator
 from ...systems.linear import LinearSystem
 from ...systems.measurements import LinearMeasurement
 from .constants import ACCELEROMETER_RANGE, P0_DIAGONAL
@@ -116,4 +116,5 @@ _BUILDERS = {
     "yang2020_fused": (build_fused, "Yang et al. 2020, Algorithm 3: fusion of Algorithms 1 and 2"),
 }
 for _name, (_builder, _text) in _BUILDERS.items():
-    register_estimator(_name, _builder, fits=_fits_for(_name), description=_text)
+    register_estimator(_name, _builder, fits=_fits_for(_name), description=_text,
+                       requires=Requires(model="yang2020", linear=True, measurement=({"position": "displacement_attitude", "dragfree": "saturated_accelerometer", "full": "displacement_attitude+saturated_accelerometer"}[SUBSYSTEM_OF[_name]],)))
