@@ -51,7 +51,9 @@ def _small_options(key, monkeypatch):
                                                                 filters=("ekf_hill",)))
         return {}
     if key == "benchmark":
-        return {"runs": 1, "client": "serial", "estimators": ("published",)}
+        return {"runs": 1, "client": "serial", "scenarios": ("sun2011",), "bound_runs": 1,
+                "grids": {"sun2011": {"maneuver": [False], "delta": [0.0], "noise": ["gaussian"]}},
+                "estimators": {"sun2011": ("published",)}}
     if key == "attitude2018":
         from hinfnav.papers.attitude2018 import Scenario
 
