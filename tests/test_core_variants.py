@@ -305,3 +305,33 @@ def test_rate_adaptive_names_the_states_it_needs():
         RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0)
     with pytest.raises(InputError, match="states"):
         RateAdaptiveEKF(SYSTEM, measurement([0, 1]), P0=P0, states=[2, 7])
+
+
+def test_one_joseph_form_and_one_gain_freeze_in_the_package():
+    # issue 17 "one core": scan the package's source. Expected: the Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ is
+    # written once (hinfnav.core.linalg.joseph_covariance; the Kalman filters, Algorithm 2 and the PCRB call it)
+    # and the steady-gain freeze once (hinfnav.estimators.steady.freeze_gain). A copy added anywhere fails this.
+    import re
+    from pathlib import Path
+
+    import hinfnav
+
+    root = Path(hinfnav.__file__).parent
+    joseph = re.compile(r"eye\([^)]*\)\s*-\s*(?:matmul_shared\(\s*)?K\w*\s*[,@]|K\w*\s*@\s*R\w*\s*@\s*K\w*\.T")
+    freeze = re.compile(r"def\s+\w*(?:freeze|frozen|converged)\w*\s*\(")
+    found = {"joseph": set(), "freeze": set()}
+    for path in root.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        rel = path.relative_to(root).as_posix()
+        if joseph.search(text):
+            found["joseph"].add(rel)
+        for match in freeze.finditer(text):
+            found["freeze"].add(f"{rel}:{match.group(0)}")
+    assert found["joseph"] == {"core/linalg.py"}, found["joseph"]
+    assert found["freeze"] == {"estimators/steady.py:def freeze_gain(", "estimators/steady.py:def _converged("}, found
+    from hinfnav.analysis import pcrb
+    from hinfnav.core.linalg import joseph_covariance
+    from hinfnav.estimators import correction, saturated_state
+
+    for module in (correction, saturated_state, pcrb):  # the users call the one function
+        assert module.joseph_covariance is joseph_covariance
