@@ -161,6 +161,44 @@ def test_huber_on_the_attitude_filter_downweights_a_bad_star_vector(truth):
     assert err(hist) < err(plain)
 
 
+def test_huber_on_the_attitude_filter_is_the_exact_huber_minimiser_at_every_update(truth):
+    # Independent certificate, at every update of both runs (a 10 mrad bad star vector at step 20, and step 0's
+    # large initial errors, put rows beyond γ): the correction δx the filter returns is the minimiser of the
+    # convex Huber cost Σρ(ζ), ζ = [L_R⁻¹(H δx − ν); L_P⁻¹ δx]: the Newton step to the zero of its gradient
+    # Mᵀ clip(ζ, ±γ) (Hessian Mᵀ diag(|ζ| ≤ γ) M, the cost being piecewise quadratic) is below 1e-8 posterior σ
+    # (measured 7e-10; the solver stops at tol = 1e-13); its weights are ψ = min(1, γ/|ζ|) and its P⁺ is
+    # (Mᵀ Ψ M)⁻¹ (Karlgaard & Schaub 2007); all recomputed here in plain numpy from the inputs the attitude
+    # filter hands its correction. P⁺ to 1e-8 relative plus 1e-9 of max|P⁻|: the filter forms P⁺ as
+    # P⁻ − U T⁻¹ Uᵀ (matrix inversion lemma), which cancels digits when P⁺ ≪ P⁻ (step 0: P₀ against arcsecond
+    # star readings; measured 8e-11 of max|P⁻|, i.e. 3e-4 of that P⁺ entry: a finding, not a tuning).
+    calls = []
+
+    class Spy(AttitudeHuberEKF):
+        def correct_error(self, P, H, R, innovation):
+            dx, P_post, diag = super().correct_error(P, H, R, innovation)
+            calls.append((P, H, R, innovation, dx, P_post, diag["weights"]))
+            return dx, P_post, diag
+
+    y = truth.y.copy()
+    y[0, 20, 0] += 0.01
+    _attitude(Spy, truth, y=y, gamma=1.345, tol=1e-13, max_iter=200)
+    gamma, active = 1.345, 0
+    for P, H, R, nu, dx, P_post, weights in calls:
+        for r in range(nu.shape[0]):
+            Hr, Rr = (H[r] if H.ndim == 3 else H), (R[r] if R.ndim == 3 else R)
+            M = np.vstack([np.linalg.solve(np.linalg.cholesky(Rr), Hr), np.linalg.inv(np.linalg.cholesky(P[r]))])
+            rhs = np.concatenate([np.linalg.solve(np.linalg.cholesky(Rr), nu[r]), np.zeros(P.shape[-1])])
+            zeta = M @ dx[r] - rhs
+            w = np.minimum(1.0, gamma / np.maximum(np.abs(zeta), 1e-300))
+            P_ref = np.linalg.inv(M.T @ (w[:, None] * M))
+            newton = np.linalg.solve(M.T @ ((np.abs(zeta) <= gamma)[:, None] * M), M.T @ np.clip(zeta, -gamma, gamma))
+            assert np.all(np.abs(newton) <= 1e-8 * np.sqrt(np.diag(P_ref))), newton
+            np.testing.assert_allclose(weights[r], w, rtol=1e-8)
+            np.testing.assert_allclose(P_post[r], P_ref, rtol=1e-8, atol=1e-9 * np.abs(P[r]).max())
+            active += bool(np.any(w < 1))
+    assert active >= 3  # Huber acted (weights < 1) at several updates, not only on the bad vector
+
+
 def _attitude(cls, truth, y=None, **kw):
     from hinfnav.papers.attitude2018.filters import build_aekf
 
