@@ -151,13 +151,18 @@ def test_step_loop_equals_batch_estimate(case):
     state = est.start(sc.xhat0, None, truth.x.shape[0])
     n1 = truth.x.shape[1]
     xhat = np.empty_like(batch.xhat)
+    P = None if batch.P is None else np.empty(batch.P.shape)
     for k in range(n1):
         state, out = est.update(state, truth.y[:, k])
         xhat[:, k] = out.xhat
         assert "innovation" in out.diagnostics or out.P is None  # Kalman-type filters report their innovation
+        if P is not None:
+            P[:, k] = out.P
         if k < n1 - 1:
             state = est.predict(state, truth.u[:, k])
     np.testing.assert_allclose(xhat, batch.xhat, rtol=1e-12, atol=1e-15 * np.abs(batch.xhat).max())
+    if P is not None:  # the covariance the step reports is the batch's too
+        np.testing.assert_allclose(P, batch.P, rtol=1e-12, atol=1e-15 * np.abs(batch.P).max())
 
 
 def test_converges_without_noise_on_a_stable_problem(case):

@@ -212,27 +212,6 @@ def test_huber_filter_accepts_a_dynamics_model():
     np.testing.assert_allclose(Pa, Pb, rtol=1e-9, atol=1e-9)
 
 
-def test_step_interface_checks_y_u_and_order():
-    ukf = SigmaPointFilter(MODEL, SENSOR, P0=P0)
-    state = ukf.start(X0, None, 2)
-    with pytest.raises(InputError, match=r"y at step 0 .*got \(2, 3\)"):
-        ukf.update(state, np.ones((2, 3)))
-    with pytest.raises(InputError, match=r"y at step 0 .*NaN or inf"):
-        ukf.update(state, np.array([[1000.0, np.nan], [1000.0, 0.1]]))
-    state, _ = ukf.update(state, np.array([[1500.0, 2.9], [1500.0, 2.9]]))
-    with pytest.raises(InputError, match="wrong call order at step 0"):
-        ukf.update(state, np.array([[1500.0, 2.9], [1500.0, 2.9]]))
-    with pytest.raises(InputError, match="xhat0"):
-        ukf.start(X0[:3])
-    spec = StateSpec(("p", "v"), ("m", "m/s"))
-    sys = LinearSystem(np.eye(2), np.array([[0.0], [1.0]]), 0.1 * np.eye(2), 1.0, spec)
-    lin = SigmaPointFilter(sys, LinearMeasurement(np.array([[1.0, 0.0]]), np.array([[1.0]])), P0=np.eye(2),
-                           uses_input=True)
-    state, _ = lin.update(lin.start([0.0, 0.0]), np.array([[0.5]]))
-    with pytest.raises(InputError, match=r"u at step 0 .*NaN or inf"):
-        lin.predict(state, np.array([[np.nan]]))
-
-
 def test_quaternion_states_through_error_coordinates():
     # (U6) on paper 002's gyroless attitude problem. Independent reference: the attitude EKF (AEKF,
     # hinfnav.estimators.attitude). As α → 0 the unscented transform tends to the linearisation, so the UKF with

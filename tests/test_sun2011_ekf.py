@@ -188,20 +188,6 @@ def test_timing_convention(short_scenario):
     np.testing.assert_allclose(pred.xhat[0, 1:], filt.xhat[0, :-1] @ Phi.T, atol=1e-9)
 
 
-def test_step_contract_equals_batch_estimate(short_scenario):
-    # start / update / predict by hand (the loop a controller sits in) gives the batch numbers
-    sc = short_scenario
-    truth = simulate_truth(sc.truth_model(maneuver=True), runs=2, seed=4)
-    ekf = build_ekf(sc, known_input=True)
-    hist = ekf.estimate(truth.y, truth.u, sc.xhat0)
-    state = ekf.start(sc.xhat0, runs=2)
-    for k in range(truth.t.size):
-        state, out = ekf.update(state, truth.y[:, k])
-        np.testing.assert_array_equal(out.xhat, hist.xhat[:, k])
-        np.testing.assert_array_equal(out.P, hist.P[:, k])
-        state = ekf.predict(state, truth.u[:, k])
-
-
 def test_keep_covariance_and_diagnostics(short_scenario):
     # estimate(keep_covariance=False) drops P (it replaces the old constructor argument);
     # diagnostics=True returns the innovation history y(k) − C x̂(k|k−1)

@@ -76,7 +76,7 @@ import scipy.stats
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
-from ..core.linalg import as_covariance
+from ..core.linalg import as_covariance, joseph_covariance
 from ..core.validation import as_int_at_least, as_matrix, as_positive
 from ..noise import GaussianNoise, LaplaceNoise, MixtureNoise, NoiseModel, StudentTNoise
 
@@ -118,9 +118,7 @@ def _add_information(P, M):
     LP = L @ P
     S = LP @ L.T + np.eye(L.shape[0])
     K = np.linalg.solve(S, LP).T
-    IKL = np.eye(P.shape[0]) - K @ L
-    out = IKL @ P @ IKL.T + K @ K.T
-    return 0.5 * (out + out.T)
+    return joseph_covariance(P, K, L, np.eye(L.shape[0]))  # (I − K L) P (I − K L)ᵀ + K Kᵀ, symmetrised
 
 
 def posterior_crb(truth_states: ArrayLike, dynamics_jacobian: Any,

@@ -1,9 +1,11 @@
 """Small linear-algebra helpers shared by every layer.
 
 Nothing here knows about a paper, a system or an estimator: spectral radius,
-symmetric part, covariance checks, zero-order-hold discretization, and the
+symmetric part, covariance checks, zero-order-hold discretization, the
 inverse of a batch of small symmetric positive definite matrices (the
-innovation covariances of filters run with a leading runs dimension).
+innovation covariances of filters run with a leading runs dimension), and the
+package's one Joseph-form covariance update (the Kalman filters' and the
+posterior Cramér–Rao bound's).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from .exceptions import InputError
 from .validation import as_choice, as_matrix, as_positive
 
 __all__ = ["spectral_radius", "sym", "as_covariance", "discretize", "inv_spd", "matmul_shared", "congruence",
-           "SERIAL_PRODUCT_SIZE"]
+           "joseph_covariance", "SERIAL_PRODUCT_SIZE"]
 
 
 def spectral_radius(A):
@@ -206,3 +208,21 @@ def congruence(F, P):
         return F @ P @ np.swapaxes(F, -1, -2)
     FT = F.T
     return matmul_shared(np.swapaxes(matmul_shared(P, FT), -1, -2), FT)
+
+
+def joseph_covariance(P: NDArray[np.float64], K: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], *,
+                      symmetrize: bool = True) -> NDArray[np.float64]:
+    """The Joseph-form posterior ``(I − K H) P (I − K H)ᵀ + K R Kᵀ`` for a given gain K, batched.
+
+    Eq. (J2) of :mod:`hinfnav.estimators.correction` (P, R in the squared
+    units of the state and the reading). Valid for any gain: the optimal one
+    of (J1), one with some columns set to 0 for readings that are not used
+    (Algorithm 2 on a skipped clipped reading), or an information update with
+    R = I (the posterior Cramér–Rao bound's). The package's one Joseph form.
+    Shapes broadcast: P (..., n, n), K (..., n, m), H (..., m, n), R (..., m, m).
+    """
+    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
+    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
+    if symmetrize:
+        P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
+    return P_post

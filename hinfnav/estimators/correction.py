@@ -2,7 +2,9 @@
 
 :func:`joseph_update` is the one Joseph-form update of the package (the EKF,
 the Huber filter's Kalman start, the augmented and attitude filters, the
-extended-state Algorithm 1 and, through it, Algorithm 3):
+extended-state Algorithm 1 and, through it, Algorithm 3); its covariance (J2)
+is :func:`hinfnav.core.linalg.joseph_covariance` (re-exported here), which
+Algorithm 2 and the posterior Cramér–Rao bound call directly:
 
 * ``S = H P Hᵀ + R``, ``K = P Hᵀ S⁻¹``, ``δx = K ν``                       (J1)
 * ``P⁺ = (I − K H) P (I − K H)ᵀ + K R Kᵀ``                              (J2)
@@ -29,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.linalg import inv_spd, matmul_shared
+from ..core.linalg import inv_spd, joseph_covariance, matmul_shared
 
 __all__ = ["KalmanCorrection", "drop_missing", "joseph_covariance", "joseph_update", "kalman_gain"]
 
@@ -88,21 +90,6 @@ def kalman_gain(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.fl
         S = matmul_shared(_swap(PHT), HT) + R
     K = PHT @ inv_spd(S)
     return K, joseph_covariance(P, K, H, R, symmetrize=symmetrize), S
-
-
-def joseph_covariance(P: NDArray[np.float64], K: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], *,
-                      symmetrize: bool = True) -> NDArray[np.float64]:
-    """The Joseph-form posterior (J2) ``(I − K H) P (I − K H)ᵀ + K R Kᵀ`` for a given gain K, batched.
-
-    Valid for any gain (the optimal one of (J1), or one with some columns set
-    to 0 for readings that are not used, as Algorithm 2 does on a skipped
-    clipped reading). Shapes broadcast: P (..., n, n), K (..., n, m), H (..., m, n), R (..., m, m).
-    """
-    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
-    P_post = I_KH @ P @ _swap(I_KH) + matmul_shared(K, R) @ _swap(K)
-    if symmetrize:
-        P_post = 0.5 * (P_post + _swap(P_post))
-    return P_post
 
 
 def joseph_update(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64], *,

@@ -166,17 +166,8 @@ def build_ukf(scenario, *, rule="unscented", alpha=1.0, beta=2.0, kappa=0.0, bas
     :class:`~hinfnav.estimators.SigmaPointFilter`; ``options`` go to the
     Kalman filter's builder.
     """
-    points = {"rule": rule, "alpha": alpha, "beta": beta, "kappa": kappa}
-    if isinstance(scenario, Scenario):
-        if base is not None:
-            raise InputError("base applies only to scenarios of other papers")
-        options.setdefault("measurement", "direct")
-        return SigmaPointFilter.from_ekf(EKF(scenario, **options), name="ukf", **points)
-    base = _base_name(scenario) if base is None else base
-    if base is None:
-        raise InputError(f"ukf needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}); "
-                         f"{type(scenario).__name__} has none")
-    return SigmaPointFilter.from_ekf(build_estimator(base, scenario, **options), name="ukf", **points)
+    return SigmaPointFilter.from_ekf(_kalman_base(scenario, base, options, "ukf"), name="ukf", rule=rule, alpha=alpha,
+                                     beta=beta, kappa=kappa)
 
 
 def _kalman_base(scenario, base, options, what):
