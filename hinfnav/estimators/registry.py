@@ -51,7 +51,7 @@ class Offers:
     linear : bool
         Its dynamics are linear (a LinearSystem), as the LMI designs need.
     models : tuple of str
-        Models it hands to builders: a paper's key (its own scenario object, e.g. ``"sun2011"``) and/or
+        Models it hands to builders: a paper's key (its own scenario object, by the key its provider registers) and/or
         ``"kalman"`` (a generic ``kalman_model()``: system, measurement, P0, Q, uses_input).
     """
 
