@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.exceptions import InputError
+from ...core.renames import renamed_keywords
 from ...core.validation import as_choice, as_int_at_least
 from ...estimators.augmented import (
     AugmentedInputAdaptiveKF,
@@ -262,12 +263,14 @@ _STYLE = {
 }
 
 
+@renamed_keywords(window_s="moving_rms_s")
 def plot_chaser(study, *, axes=None, moving_rms_s=10.0):
     """Fig 4 with the ideas added: per-axis position and velocity errors of run 0, every filter.
 
     Each curve is the moving RMS of the error over the last ``moving_rms_s`` seconds (log scale),
     so that the unaware EKF's metres and the others' centimetres show
-    together and the noisy curves do not hide each other.
+    together and the noisy curves do not hide each other. ``moving_rms_s`` was ``window_s`` before
+    issue 23 (still accepted until hinfnav 0.3, with a DeprecationWarning).
 
     Returns
     -------

@@ -67,7 +67,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     table = benchmark_table(results)
     names = list(dict.fromkeys(table["estimator"]))
     note = _note(runs)
-    table.to_csv(out / "table.csv", index=False)
+    atomic_write_text(out / "table.csv", table.to_csv(index=False), newline="")
     atomic_write_text(out / "table.md", format_markdown(table, note=note))
     rep.save_figure(plot_heatmap(table), "heatmap")
     cells = [{**c["params"], "cell_id": c["cell_id"], "seed": c["seed"], "runs": c["runs"], "status": c["status"],
