@@ -80,6 +80,7 @@ WINDOWS = ((0.0, 500.0), (500.0, 1000.0))
 VARIANTS = ("plain", "st", "adaptive")
 
 
+@renamed_keywords(window="memory_steps")
 def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_std=P0_THRUST_STD, name=None, **options):
     """The thrust-augmented EKF of Sun 2011's chaser (see the module docstring).
 
@@ -93,7 +94,8 @@ def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_
     P0_input_std : float
         Initial σ of the thrust estimate, N.
     **options
-        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``memory_steps``, ``floor`` (adaptive).
+        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``memory_steps``, ``floor`` (adaptive; ``memory_steps`` was
+        ``window`` before issue 23, still accepted until hinfnav 0.3 with a DeprecationWarning).
 
     Returns
     -------
