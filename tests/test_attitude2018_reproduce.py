@@ -18,6 +18,7 @@ from hinfnav.papers.attitude2018 import (
     reproduce,
 )
 from hinfnav.papers.attitude2018.reproduce import summarize
+from hinfnav.plotting.save import read_provenance
 
 SHORT = Scenario(orbits=0.25)
 
@@ -62,3 +63,14 @@ def test_same_seed_same_numbers():
     assert a == b
     c = attitude_study(sc, runs=2, seed=4)
     assert not np.allclose(c.main["aekf"].euler_rms_deg, st.main["aekf"].euler_rms_deg, rtol=1e-6)
+
+
+def test_every_figure_file_carries_the_summarys_provenance(out):
+    # issue 23: the files of this run, read back (PNG text chunk, PDF Info); the provenance of summary.json
+    d, _ = out
+    prov = json.loads((d / "summary.json").read_text())["provenance"]
+    assert prov["paper"] == "attitude2018"
+    files = sorted(d.glob("*.png")) + sorted(d.glob("*.pdf"))
+    assert len(files) >= 22  # every figure of the run, each format
+    for f in files:
+        assert read_provenance(f) == prov, f.name

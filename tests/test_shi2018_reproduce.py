@@ -20,6 +20,7 @@ from hinfnav.papers.shi2018 import (
     run_case,
 )
 from hinfnav.papers.shi2018.reproduce import _run_jobs
+from hinfnav.plotting.save import read_provenance
 
 TINY = Scenario(duration_s=40.0, maneuver_time_s=20.0, rms_window_s=(10.0, 40.0))
 
@@ -98,3 +99,14 @@ def test_mixture_claim_reproduces(full_cases):
     m = full_cases["mixture"]
     gap = paired_gap(m.filters["hbf"], m.filters["ekf"])
     assert gap["pos_ci95_m"][1] < 0 and gap["vel_ci95_mps"][1] < 0, gap
+
+
+def test_every_figure_file_carries_the_summarys_provenance(written):
+    # issue 23: the files of this run, read back (PNG text chunk, PDF Info); the provenance of summary.json
+    d, _ = written
+    prov = json.loads((d / "summary.json").read_text())["provenance"]
+    assert prov["paper"] == "shi2018"
+    files = sorted(d.glob("*.png")) + sorted(d.glob("*.pdf"))
+    assert len(files) >= 16  # every figure of the run, each format
+    for f in files:
+        assert read_provenance(f) == prov, f.name

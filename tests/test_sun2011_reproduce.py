@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from hinfnav.papers.sun2011 import PAPER_TABLE1, reproduce, table1
+from hinfnav.plotting.save import read_provenance
 
 RUNS = 8
 
@@ -118,3 +119,14 @@ def test_same_seed_same_numbers():
     c = table1(runs=3, seed=6)
     assert c.cells["maneuver"]["hinf_published"]["pos_m"] != a.cells["maneuver"]["hinf_published"]["pos_m"]
     np.testing.assert_equal(a.ekf_windows, b.ekf_windows)
+
+
+def test_every_figure_file_carries_the_summarys_provenance(out):
+    # issue 23: the files of this run, read back (PNG text chunk, PDF Info); the provenance of summary.json
+    d, _ = out
+    prov = json.loads((d / "summary.json").read_text())["provenance"]
+    assert prov["paper"] == "sun2011"
+    files = sorted(d.glob("*.png")) + sorted(d.glob("*.pdf"))
+    assert len(files) >= 12  # every figure of the run, each format
+    for f in files:
+        assert read_provenance(f) == prov, f.name

@@ -12,6 +12,7 @@ import pytest
 import hinfnav as hn
 from hinfnav.papers.yang2020 import Scenario, reproduce
 from hinfnav.papers.yang2020.claims import VERDICTS
+from hinfnav.plotting.save import read_provenance
 
 
 @pytest.fixture(scope="module")
@@ -66,3 +67,14 @@ def test_too_many_runs_is_refused_before_any_work(tmp_path):
     with pytest.raises(hn.InputError, match="runs"):
         reproduce(tmp_path / "x", runs=9, progress=False)
     assert not (tmp_path / "x").exists()
+
+
+def test_every_figure_file_carries_the_summarys_provenance(summary):
+    # issue 23: the files of this run, read back (PNG text chunk, PDF Info); the provenance of summary.json
+    d, _ = summary
+    prov = json.loads((d / "summary.json").read_text())["provenance"]
+    assert prov["paper"] == "yang2020"
+    files = sorted(d.glob("*.png")) + sorted(d.glob("*.pdf"))
+    assert len(files) >= 8  # every figure of the run, each format
+    for f in files:
+        assert read_provenance(f) == prov, f.name
