@@ -18,6 +18,7 @@ from hinfnav.papers.attitude2018 import (
     reproduce,
 )
 from hinfnav.papers.attitude2018.reproduce import summarize
+from hinfnav.plotting.save import read_provenance
 
 SHORT = Scenario(orbits=0.25)
 
@@ -62,3 +63,10 @@ def test_same_seed_same_numbers():
     assert a == b
     c = attitude_study(sc, runs=2, seed=4)
     assert not np.allclose(c.main["aekf"].euler_rms_deg, st.main["aekf"].euler_rms_deg, rtol=1e-6)
+
+
+def test_every_figure_file_carries_the_summarys_provenance(out):
+    # issue 23: this run's files read back (PNG text chunk, PDF Info) hold summary.json's provenance
+    prov = json.loads((out[0] / "summary.json").read_text())["provenance"]
+    files = sorted(out[0].glob("*.p[nd][gf]"))  # every figure of the run, each format
+    assert prov["paper"] == "attitude2018" and len(files) >= 22 and [read_provenance(f) for f in files] == [prov] * len(files)

@@ -71,7 +71,7 @@ def test_the_adaptive_filters_memory_is_memory_steps_and_window_still_works_with
     sc = AttitudeScenario(orbits=0.25)
     assert build_aaekf(sc).memory_steps == 60  # paper 002's default m (constants.DEFAULT_AA)
     assert build_aaekf(sc, memory_steps=7).memory_steps == 7
-    with pytest.warns(DeprecationWarning, match="window is deprecated, use memory_steps"):
+    with pytest.warns(DeprecationWarning, match="'window' is deprecated, use 'memory_steps'"):
         assert build_aaekf(sc, window=9).memory_steps == 9
     with pytest.raises(InputError, match="memory_steps"):
         build_aaekf(sc, memory_steps=0)

@@ -20,6 +20,7 @@ from hinfnav.papers.shi2018 import (
     run_case,
 )
 from hinfnav.papers.shi2018.reproduce import _run_jobs
+from hinfnav.plotting.save import read_provenance
 
 TINY = Scenario(duration_s=40.0, maneuver_time_s=20.0, rms_window_s=(10.0, 40.0))
 
@@ -98,3 +99,10 @@ def test_mixture_claim_reproduces(full_cases):
     m = full_cases["mixture"]
     gap = paired_gap(m.filters["hbf"], m.filters["ekf"])
     assert gap["pos_ci95_m"][1] < 0 and gap["vel_ci95_mps"][1] < 0, gap
+
+
+def test_every_figure_file_carries_the_summarys_provenance(written):
+    # issue 23: this run's files read back (PNG text chunk, PDF Info) hold summary.json's provenance
+    prov = json.loads((written[0] / "summary.json").read_text())["provenance"]
+    files = sorted(written[0].glob("*.p[nd][gf]"))  # every figure of the run, each format
+    assert prov["paper"] == "shi2018" and len(files) >= 16 and [read_provenance(f) for f in files] == [prov] * len(files)

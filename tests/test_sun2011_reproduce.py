@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from hinfnav.papers.sun2011 import PAPER_TABLE1, reproduce, table1
+from hinfnav.plotting.save import read_provenance
 
 RUNS = 8
 
@@ -118,3 +119,10 @@ def test_same_seed_same_numbers():
     c = table1(runs=3, seed=6)
     assert c.cells["maneuver"]["hinf_published"]["pos_m"] != a.cells["maneuver"]["hinf_published"]["pos_m"]
     np.testing.assert_equal(a.ekf_windows, b.ekf_windows)
+
+
+def test_every_figure_file_carries_the_summarys_provenance(out):
+    # issue 23: this run's files read back (PNG text chunk, PDF Info) hold summary.json's provenance
+    prov = json.loads((out[0] / "summary.json").read_text())["provenance"]
+    files = sorted(out[0].glob("*.p[nd][gf]"))  # every figure of the run, each format
+    assert prov["paper"] == "sun2011" and len(files) >= 12 and [read_provenance(f) for f in files] == [prov] * len(files)

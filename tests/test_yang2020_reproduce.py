@@ -12,6 +12,7 @@ import pytest
 import hinfnav as hn
 from hinfnav.papers.yang2020 import Scenario, reproduce
 from hinfnav.papers.yang2020.claims import VERDICTS
+from hinfnav.plotting.save import read_provenance
 
 
 @pytest.fixture(scope="module")
@@ -66,3 +67,10 @@ def test_too_many_runs_is_refused_before_any_work(tmp_path):
     with pytest.raises(hn.InputError, match="runs"):
         reproduce(tmp_path / "x", runs=9, progress=False)
     assert not (tmp_path / "x").exists()
+
+
+def test_every_figure_file_carries_the_summarys_provenance(summary):
+    # issue 23: this run's files read back (PNG text chunk, PDF Info) hold summary.json's provenance
+    prov = json.loads((summary[0] / "summary.json").read_text())["provenance"]
+    files = sorted(summary[0].glob("*.p[nd][gf]"))  # every figure of the run, each format
+    assert prov["paper"] == "yang2020" and len(files) >= 8 and [read_provenance(f) for f in files] == [prov] * len(files)

@@ -39,7 +39,6 @@ passed κ uses the steps available.
 
 from __future__ import annotations
 
-import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -47,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import matmul_shared
+from ..core.deprecation import renamed_keywords
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
 
 if TYPE_CHECKING:
@@ -277,12 +277,10 @@ class RateAdaptive:
     data_dependent_covariance = True
     defers_prior = True
 
+    @renamed_keywords(window="memory_steps")
     def __init__(self, *args: Any, memory_steps: int = 60, epsilon: float = 1.0, floor: float = 1.0,
-                 states: Any = None, window: int | None = None, **kwargs: Any) -> None:
+                 states: Any = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        if window is not None:
-            warnings.warn("window is deprecated, use memory_steps (m, steps)", DeprecationWarning, stacklevel=2)
-            memory_steps = window
         self.memory_steps = as_int_at_least("memory_steps", memory_steps, 1)
         self.epsilon = per_run_parameter("epsilon", epsilon, as_positive)
         self.floor = as_nonnegative("floor", floor)

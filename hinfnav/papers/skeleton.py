@@ -33,11 +33,15 @@ from .notebooks import check_notebooks, run_notebooks
 __all__ = ["Reproduction", "atomic_write_text"]
 
 
-def atomic_write_text(path, text, encoding="utf-8"):
-    """Write ``text`` to ``path`` through a temporary file beside it and :func:`os.replace` (never half a file)."""
+def atomic_write_text(path, text, encoding="utf-8", newline=None):
+    """Write ``text`` to ``path`` through a temporary file beside it and :func:`os.replace` (never half a file).
+
+    ``newline=""`` writes the line ends as they are in ``text`` (what :mod:`csv` needs); the default
+    translates ``"\\n"`` to the platform's line end, like :meth:`pathlib.Path.write_text`.
+    """
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding=encoding)
+    tmp.write_text(text, encoding=encoding, newline=newline)
     os.replace(tmp, path)
     return path
 

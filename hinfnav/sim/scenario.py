@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.exceptions import InputError
+from ..core.deprecation import translate_keywords
 
 __all__ = ["Scenario", "renamed_fields"]
 
@@ -94,16 +95,7 @@ class Scenario:
 
 def _translate(cls: type, changes: dict[str, Any]) -> dict[str, Any]:
     """``changes`` with deprecated keywords of ``cls`` renamed (each with a DeprecationWarning)."""
-    out = {}
-    for key, value in changes.items():
-        new = cls.RENAMED.get(key)
-        if new is not None:
-            if new in changes:
-                raise InputError(f"{cls.__name__}: give {new!r} only ({key!r} is its deprecated name)")
-            warnings.warn(f"{cls.__name__}: {key!r} is deprecated, use {new!r}", DeprecationWarning, stacklevel=3)
-            key = new
-        out[key] = value
-    return out
+    return translate_keywords(cls.__name__, cls.RENAMED, changes, stacklevel=4)
 
 
 def renamed_fields(**renamed: str):

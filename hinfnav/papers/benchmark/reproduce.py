@@ -138,7 +138,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     best = winners(table)
     note = (f"{runs} Monte Carlo runs per cell (seeds from the cell, common to every estimator of a grid point); "
             f"ratios over the `{WINDOW}` window of each scenario.")
-    table.drop(columns="conditions").to_csv(out / "table.csv", index=False)
+    atomic_write_text(out / "table.csv", table.drop(columns="conditions").to_csv(index=False), newline="")
     atomic_write_text(out / "table.md", _markdown(table, best, note))
     for key in dict.fromkeys(table["scenario"]):
         rep.save_figure(plot_scenario_heatmap(table, key), f"heatmap_{key}")

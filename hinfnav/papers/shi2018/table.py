@@ -7,10 +7,12 @@ CSV and Markdown by :func:`write_table`.
 """
 
 import csv
+import io
 from pathlib import Path
 
 from ...core.exceptions import InputError
 from ...metrics.intervals import format_interval
+from ..skeleton import atomic_write_text
 
 __all__ = ["TABLE_FILTERS", "table_rows", "format_table", "write_table"]
 
@@ -79,16 +81,17 @@ def format_table(summary):
 
 
 def write_table(summary, out_dir, name="results"):
-    """Write ``<name>.csv`` and ``<name>.md`` into ``out_dir``; returns their paths."""
+    """Write ``<name>.csv`` and ``<name>.md`` into ``out_dir`` (each atomically); returns their paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rows = table_rows(summary)
     csv_path = out / f"{name}.csv"
-    with csv_path.open("w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=_COLUMNS)
-        writer.writeheader()
-        for r in rows:
-            writer.writerow({k: ("" if v is None else v) for k, v in r.items()})
+    fh = io.StringIO(newline="")
+    writer = csv.DictWriter(fh, fieldnames=_COLUMNS)
+    writer.writeheader()
+    for r in rows:
+        writer.writerow({k: ("" if v is None else v) for k, v in r.items()})
+    atomic_write_text(csv_path, fh.getvalue(), newline="")
     md_path = out / f"{name}.md"
-    md_path.write_text("# Shi & Wang (2018), results (Table 2 rebuilt)\n\n" + format_table(summary))
+    atomic_write_text(md_path, "# Shi & Wang (2018), results (Table 2 rebuilt)\n\n" + format_table(summary))
     return csv_path, md_path

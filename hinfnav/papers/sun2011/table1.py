@@ -16,6 +16,7 @@ Conventions (the paper does not state them; see the notebooks for why):
 """
 
 import csv
+import io
 import json
 import textwrap
 from dataclasses import dataclass, field
@@ -37,6 +38,7 @@ from .designs import design_for_scenario
 from .filters import lti_from_matrices, make_estimator
 from .limits import kalman_limit
 from .scenario import Scenario
+from ..skeleton import atomic_write_text
 
 __all__ = ["TABLE_FILTERS", "filter_labels", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows",
            "format_table1", "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
@@ -383,7 +385,7 @@ def _wrap(line, width):
 
 
 def write_table1(tab, out_dir, provenance=None):
-    """Write ``table1.csv`` and ``table1.md`` into ``out_dir``; return their paths.
+    """Write ``table1.csv`` and ``table1.md`` into ``out_dir`` (each atomically); return their paths.
 
     The CSV starts with ``#`` comment lines holding the provenance (read it
     with ``pandas.read_csv(path, comment="#")``); the Markdown ends with it.
@@ -392,18 +394,20 @@ def write_table1(tab, out_dir, provenance=None):
     rows = table1_rows(tab)
     prov = provenance or {}
     csv_path = out_dir / "table1.csv"
-    with open(csv_path, "w", newline="") as fh:
-        for k, v in prov.items():
-            fh.write(f"# {k}: {json.dumps(v)}\n")
-        w = csv.writer(fh)
-        w.writerow(["case", "filter", "pos_m_single_run", "vel_mps_single_run", "pos_m_mc_mean", "pos_m_mc_ci95_lo",
-                    "pos_m_mc_ci95_hi", "vel_mps_mc_mean", "vel_mps_mc_ci95_lo", "vel_mps_mc_ci95_hi", "cli", "note"])
-        for r in rows:
-            mc = [r.get("mc_pos_m"), *(r.get("mc_pos_ci95") or [None, None]), r.get("mc_vel_mps"),
-                  *(r.get("mc_vel_ci95") or [None, None])]
-            w.writerow([r["case"], r["filter"], r["pos_m"], r["vel_mps"], *mc, r.get("cli", ""), r.get("note", "")])
+    fh = io.StringIO(newline="")
+    for k, v in prov.items():
+        fh.write(f"# {k}: {json.dumps(v)}\n")
+    w = csv.writer(fh)
+    w.writerow(["case", "filter", "pos_m_single_run", "vel_mps_single_run", "pos_m_mc_mean", "pos_m_mc_ci95_lo",
+                "pos_m_mc_ci95_hi", "vel_mps_mc_mean", "vel_mps_mc_ci95_lo", "vel_mps_mc_ci95_hi", "cli", "note"])
+    for r in rows:
+        mc = [r.get("mc_pos_m"), *(r.get("mc_pos_ci95") or [None, None]), r.get("mc_vel_mps"),
+              *(r.get("mc_vel_ci95") or [None, None])]
+        w.writerow([r["case"], r["filter"], r["pos_m"], r["vel_mps"], *mc, r.get("cli", ""), r.get("note", "")])
+    atomic_write_text(csv_path, fh.getvalue(), newline="")
     md_path = out_dir / "table1.md"
-    md_path.write_text(
+    atomic_write_text(
+        md_path,
         "# Table 1: relative navigation accuracy, paper vs reproduced\n\n"
         + format_table1(tab, markdown=True)
         + "\n\nError measure: " + tab.settings["error_measure"] + ".\n"
