@@ -13,10 +13,13 @@ equations computed twice); the kernels with and without outliers (the Huber
 M-estimation's iterations, the strong-tracking fading) are both exercised.
 
 CPU: the kernels compile once per installation (numba's on-disk cache, about
-13 s of CPU for the Kalman kernel and 2 s each for the others on the README's
-machine); afterwards this file takes a few seconds.
+20 s of CPU for the Kalman kernel and 2-3 s each for the others on the
+README's machine); this file takes about 33 s of CPU from an empty cache and
+10 s from a filled one. Every kernel call is in ONE test item so that under
+pytest-xdist one worker only compiles.
 """
 
+import functools
 import subprocess
 import sys
 
@@ -59,6 +62,12 @@ def _scenario(name):
     return YANG.linear_truth(SUBSYSTEM_OF[name])
 
 
+@functools.cache
+def _built(name, on_sun=False):
+    """The registered estimator on its own scenario (or the chaser's), built once for the module (designs cost)."""
+    return build_estimator(name, SUN if on_sun else _scenario(name))
+
+
 @pytest.fixture(scope="module")
 def chaser_truth():
     truth = simulate_truth(SUN.truth_model(maneuver=True), runs=3, seed=7)
@@ -71,49 +80,55 @@ def _relative(ref, got, scale):
     return float(np.max(np.abs(got - ref) / scale))
 
 
-def _assert_same(ref, got):
-    assert got.xhat.shape == ref.xhat.shape
-    assert _relative(ref.xhat, got.xhat, np.abs(ref.xhat).max(axis=(0, 1))) <= 1e-10
+def _assert_same(ref, got, what):
+    assert got.xhat.shape == ref.xhat.shape, what
+    err = _relative(ref.xhat, got.xhat, np.abs(ref.xhat).max(axis=(0, 1)))
+    assert err <= 1e-10, f"{what}: estimates differ by {err:.1e} (relative)"
     if ref.P is None:
-        assert got.P is None
+        assert got.P is None, what
         return
-    assert got.P.shape == ref.P.shape
+    assert got.P.shape == ref.P.shape, what
     d = np.sqrt(np.abs(np.diagonal(ref.P, axis1=-2, axis2=-1)).max(axis=(0, 1)))
-    assert _relative(ref.P, got.P, np.outer(d, d)) <= 1e-10
+    err = _relative(ref.P, got.P, np.outer(d, d))
+    assert err <= 1e-10, f"{what}: covariances differ by {err:.1e} (relative)"
 
 
 def test_the_kernel_lists_cover_every_registered_estimator():
     assert set(NAMES) == WITH_KERNEL | WITHOUT_KERNEL
-    have = {name for name in NAMES if kernel_status(build_estimator(name, _scenario(name))) is None}
+    have = {name for name in NAMES if kernel_status(_built(name)) is None}
     assert have == WITH_KERNEL
 
 
-@pytest.mark.parametrize("name", sorted(WITH_KERNEL))
-def test_numba_equals_numpy(name, chaser_truth):
+def test_numba_equals_numpy(chaser_truth):
+    # ONE test item for every kernel call: under pytest-xdist the kernels then compile in one worker only
+    # (a cold cache costs ~20 s of CPU per worker that compiles them).
     y, u = chaser_truth
-    est = build_estimator(name, SUN)
-    ref = est.estimate(y, u, SUN.xhat0)
-    _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"))
-    assert select_backend(est, "auto") == "numba"
-
-
-@pytest.mark.parametrize("keep", [False, "diagonal"])
-def test_numba_keeps_what_it_is_asked(keep, chaser_truth):
-    y, u = chaser_truth
-    for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
-        est = build_estimator(name, SUN)
-        ref = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep)
-        got = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep, backend="numba")
-        if keep is False:
-            assert got.P is None and ref.P is None
-        else:
-            np.testing.assert_allclose(got.P, ref.P, rtol=1e-10, atol=1e-10 * np.abs(ref.P).max())
-        np.testing.assert_allclose(got.xhat, ref.xhat, rtol=1e-10, atol=1e-10 * np.abs(ref.xhat).max())
+    for name in sorted(WITH_KERNEL):
+        est = _built(name, on_sun=True)
+        ref = est.estimate(y, u, SUN.xhat0)
+        _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"), name)
+        assert select_backend(est, "auto") == "numba"
+    for keep in (False, "diagonal"):  # the covariance kept as asked
+        for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
+            est = _built(name, on_sun=True)
+            ref = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep)
+            got = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep, backend="numba")
+            if keep is False:
+                assert got.P is None and ref.P is None
+            else:
+                np.testing.assert_allclose(got.P, ref.P, rtol=1e-10, atol=1e-10 * np.abs(ref.P).max(), err_msg=name)
+            np.testing.assert_allclose(got.xhat, ref.xhat, rtol=1e-10, atol=1e-10 * np.abs(ref.xhat).max(),
+                                       err_msg=name)
+    # theta far beyond the existence bound: the kernel's Cholesky of N fails, the NumPy path raises its error
+    ref = _built("recursive_hinf", on_sun=True)
+    est = RecursiveHInfinityFilter(ref.system, ref.measurement, theta=1e6, P0=ref.P0, Q=ref.Q, R=ref.R)
+    with pytest.raises(hn.InputError, match="theta"):
+        est.estimate(y, u, SUN.xhat0, backend="numba")
 
 
 @pytest.mark.parametrize("name", sorted(WITHOUT_KERNEL))
 def test_no_kernel_refuses_numba_and_auto_runs_numpy(name):
-    est = build_estimator(name, _scenario(name))
+    est = _built(name)
     assert kernel_status(est)
     with pytest.raises(hn.InputError, match="backend='numba' is not available"):
         est.estimate(np.zeros((1, 2, est.measurement.n_meas)), np.zeros((1, 2, max(est.n_input, 1))),
@@ -132,15 +147,6 @@ def test_backend_options_checked(chaser_truth):
     est.missing = "skip"
     assert "missing='skip'" in kernel_status(est)
     assert select_backend(est, "auto") == "numpy"
-
-
-def test_a_failing_kernel_hands_back_to_numpy(chaser_truth):
-    # theta far beyond the existence bound: the kernel's Cholesky of N fails, the NumPy path raises its error
-    y, u = chaser_truth
-    ref = build_estimator("recursive_hinf", SUN)
-    est = RecursiveHInfinityFilter(ref.system, ref.measurement, theta=1e6, P0=ref.P0, Q=ref.Q, R=ref.R)
-    with pytest.raises(hn.InputError, match="theta"):
-        est.estimate(y, u, SUN.xhat0, backend="numba")
 
 
 def test_numba_not_imported_without_the_backend():

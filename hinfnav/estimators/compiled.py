@@ -22,8 +22,11 @@ the NumPy path, which raises its own error (or flags, as it is told).
 numba is imported only when a kernel is first asked for (importing it costs
 about 1 s); the kernels are compiled with ``cache=True`` (numba's on-disk
 cache, in ``__pycache__`` beside the kernels' module, or ``NUMBA_CACHE_DIR``),
-so the compilation (about 20 s of CPU for all kernels on the machine of the
-README's speed table) is paid once per installation.
+so the compilation is paid once per installation: the first call of the five
+filters of the README's speed table in a new process costs about 26 s of CPU
+from an empty cache and 0.5 s from a filled one (``python
+benchmarks/speed_table.py --compile-cost``, on the README's machine under
+load).
 """
 
 from __future__ import annotations

@@ -1,0 +1,274 @@
+"""Speed table (issue 21): µs per step of five filters on Sun (2011)'s chaser, NumPy, numba and filterpy.
+
+Run: ``python benchmarks/speed_table.py`` (``--quick`` for a short check,
+``--big-runs N`` to replace the 10⁴-run batch by N runs, ``--repeat N``
+timings per cell, the minimum kept; ``--compile-cost`` also times the first
+call in a new process from an empty numba cache and from the filled one).
+
+On the chaser (6 states, 3 position readings, 0.1 s steps, thrust told to
+the filters that use it; the strong-tracking filter is the registered
+``ekf_augmented_thrust_st``, 9 error coordinates) it prints, for 1, 100, 200
+and 10⁴ runs (the larger batches on fewer steps), the CPU time per step of
+the whole batch:
+
+* **NumPy**: ``est.estimate(..., backend="numpy")``, today's reference path;
+* **numba**: ``est.estimate(..., backend="numba")`` (kernels already compiled
+  and cached: the first call's cost is printed separately, with
+  ``--compile-cost`` from a cold and from a warm cache);
+* **filterpy**: filterpy 2.0's loop (``predict``/``update`` per run and
+  step) on the same data where filterpy has the filter (EKF, UKF; it has no
+  Huber or strong-tracking filter, and its ``HInfinityFilter`` is another
+  filter, see :mod:`hinfnav.estimators.recursive_hinf`), timed on at most 20
+  runs and scaled linearly (its loop is per run);
+* the **estimate difference** of numba and filterpy to the NumPy reference:
+  the largest ``|Δx̂|`` over runs and steps, each state channel divided by its
+  largest ``|x̂|``;
+* the **arithmetic limit**: the floating-point operations per run and step,
+  counted from the kernels' equations (:func:`flops`), times the runs, over
+  this machine's single-core GEMM rate (OpenBLAS, one thread, 512 × 512,
+  measured in a subprocess).
+
+The machine may be shared: every cell is the minimum of ``--repeat`` timings
+of the process's CPU time (the least disturbed one; the wall clock would count
+the waits of a batch for a shared CPU); the load average at the start and the
+end is printed.
+Asserts nothing.
+"""
+
+import argparse
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
+from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
+
+import hinfnav.papers  # noqa: F401 - registers the papers' estimators
+from hinfnav.estimators import HuberFilter, build_estimator
+from hinfnav.papers.sun2011 import Scenario
+from hinfnav.sim import simulate_truth
+
+#: (runs, steps) of the table (10⁴ runs on fewer steps).
+SIZES = ((1, 2000), (100, 300), (200, 300), (10_000, 30))
+QUICK = ((1, 200), (200, 50), (10_000, 5))
+
+
+def machine():
+    """``(CPU model, physical cores, logical CPUs)`` from /proc/cpuinfo (else the platform module)."""
+    model, cores = platform.processor() or platform.machine(), set()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            phys = None
+            for line in f:
+                key, _, value = line.partition(":")
+                key, value = key.strip(), value.strip()
+                if key == "model name":
+                    model = value
+                elif key == "physical id":
+                    phys = value
+                elif key == "core id":
+                    cores.add((phys, value))
+    except OSError:
+        pass
+    return model, len(cores) or None, os.cpu_count()
+
+
+def gemm_rate():
+    """Single-core double-precision GEMM rate, flop/s (512 × 512, best CPU time of 20, one BLAS thread)."""
+    code = ("import time, numpy as np\n"
+            "a = np.random.default_rng(0).standard_normal((512, 512)); b = a.copy(); best = 1e9\n"
+            "for _ in range(20):\n"
+            "    t = time.process_time(); a @ b; best = min(best, time.process_time() - t)\n"
+            "print(2 * 512 ** 3 / best)")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    return float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                                check=True, timeout=120).stdout)
+
+
+def flops(kind, n=6, m=3, nu=3, n_aug=3):
+    """Floating-point operations per run and step counted from the kernels' equations (multiply-add = 2).
+
+    ``shared``: the mean recursion of a filter whose gain does not depend on the data (the covariance
+    recursion is shared by all runs, counted once per step and divided among them elsewhere): ``ν = y − H x``,
+    ``x + K ν``, ``F x + G u``. ``joseph``: one covariance recursion (``F P Fᵀ + Q``, (J1)-(J2)).
+    """
+    if kind == "shared":
+        return 2 * n * m + m + 2 * n * m + n + 2 * n * n + 2 * n * nu + n
+    if kind == "joseph":
+        return (4 * n**3 + n * n) + (2 * n * n * m + 2 * n * m * m + m**3 + 2 * n * m * m + 2 * n * n * m + 4 * n**3
+                                     + 4 * n * m * m + n * n) + flops("shared", n, m, nu)
+    if kind == "huber":  # the Kalman form of the M-estimation (its common case) and L_P⁻¹ δx
+        return flops("joseph", n, m, nu) + n**3 / 3 + n**3 / 3 + n * n + 2 * m * m
+    if kind == "strong":  # augmented by n_aug input states (no G u), plus (S1)-(S4)
+        na = n + n_aug
+        return flops("joseph", na, m, 0) + 2 * m * m + 2 * m * na * na + 2 * m * m * na + 2 * na * m + 3 * na * na
+    if kind == "ukf":
+        N = 2 * n + 1
+        return 2 * (n**3 / 3) + 2 * N * n * m + 4 * N * m * m + 2 * N * n * m + m**3 + 2 * n * m * m + 2 * n * m \
+            + 2 * n * m * m + 2 * n * n * m + 2 * N * n * n + 2 * N * n * n + 2 * n * n + 2 * n * nu
+    raise ValueError(kind)
+
+
+def _min_time(fn, repeat):
+    """The least of ``repeat`` CPU-time timings of ``fn()`` (this process, all threads) and its last result.
+
+    CPU time, not wall clock: on a shared machine a batch longer than a scheduler slice waits for the CPU,
+    which the wall clock would count and this does not.
+    """
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - t0)
+    return float(best), out
+
+
+def _ratio(r):
+    return f"{r:.1f}×" if r < 10 else f"{r:.0f}×"
+
+
+def _rel(ref, got):
+    return float(np.max(np.abs(got - ref) / np.abs(ref).max(axis=(0, 1))))
+
+
+def _filterpy_ekf(ekf, y, u, x0):
+    meas = ekf.measurement
+    xs = np.empty(y.shape[:2] + (ekf.n_state,))
+    for r in range(y.shape[0]):
+        f = FilterpyEKF(dim_x=ekf.n_state, dim_z=meas.n_meas, dim_u=u.shape[2])
+        f.x, f.P = np.array(x0, dtype=float), ekf.P0.copy()
+        f.F, f.Q, f.R, f.B = ekf.F, ekf.Q, ekf.R, ekf.Gamma
+        for k in range(y.shape[1]):
+            f.update(y[r, k], meas.jacobian, meas.function, residual=meas.residual)
+            xs[r, k] = f.x
+            f.predict(u=u[r, k])
+    return xs
+
+
+def _filterpy_ukf(ukf, y, u, x0):
+    sysm = ukf.system
+    xs = np.empty(y.shape[:2] + (ukf.n_state,))
+    for r in range(y.shape[0]):
+        points = MerweScaledSigmaPoints(ukf.n_state, alpha=ukf.alpha, beta=ukf.beta, kappa=ukf.kappa)
+        f = UnscentedKalmanFilter(dim_x=ukf.n_state, dim_z=ukf.measurement.n_meas, dt=ukf.dt,
+                                  hx=lambda x: ukf.measurement.H @ x,
+                                  fx=lambda x, dt, u: sysm.Phi @ x + sysm.Gamma @ u, points=points)
+        f.x, f.P, f.Q, f.R = np.array(x0, dtype=float), ukf.P0.copy(), ukf.Q, ukf.R
+        f.sigmas_f = points.sigma_points(f.x, f.P)  # the first update draws its points from the prior
+        for k in range(y.shape[1]):
+            f.update(y[r, k])
+            xs[r, k] = f.x
+            f.predict(u=u[r, k])
+    return xs
+
+
+def filters(sc):
+    """The table's filters: name → (estimator, filterpy loop or None, flop kind, shares its gain)."""
+    ekf = build_estimator("ekf_known_input", sc)
+    return {
+        "EKF": (ekf, _filterpy_ekf, "shared", True),
+        "sigma-point (UKF)": (build_estimator("ukf", sc), _filterpy_ukf, "ukf", False),
+        "Huber": (HuberFilter.from_ekf(ekf), None, "huber", False),
+        "strong tracking": (build_estimator("ekf_augmented_thrust_st", sc), None, "strong", False),
+        "recursive H∞": (build_estimator("recursive_hinf", sc), None, "shared", True),
+    }
+
+
+_FIRST_CALL = """import os, sys, time
+c0, w0 = time.process_time(), time.perf_counter()
+import hinfnav.papers
+from hinfnav.estimators import HuberFilter, build_estimator
+from hinfnav.papers.sun2011 import Scenario
+from hinfnav.sim import simulate_truth
+sc = Scenario(duration_s=2.0, rms_window_s=(0.0, 2.0))
+t = simulate_truth(sc.truth_model(maneuver=True), runs=1, seed=0)
+ests = [build_estimator(n, sc) for n in ('ekf_known_input', 'ukf', 'recursive_hinf', 'ekf_augmented_thrust_st')]
+ests.append(HuberFilter.from_ekf(ests[0]))
+c1, w1 = time.process_time(), time.perf_counter()
+for est in ests:
+    est.estimate(t.y, t.u, sc.xhat0, backend='numba')
+print(time.process_time() - c1, time.perf_counter() - w1)
+"""
+
+
+def first_call_cost():
+    """CPU and wall seconds of the first numba call of the five filters in a new process (numba imported,
+    every kernel compiled or loaded): ``((cpu, wall) from an empty cache, (cpu, wall) from the filled one)``."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        out = []
+        for _ in range(2):  # cold, then warm
+            res = subprocess.run([sys.executable, "-c", _FIRST_CALL], capture_output=True, text=True, check=True,
+                                 timeout=1800, env=env)
+            out.append(tuple(float(v) for v in res.stdout.split()[-2:]))
+    return out[0], out[1]
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeat", type=int, default=5, help="timings per cell, the minimum kept (default 5)")
+    p.add_argument("--quick", action="store_true", help="short sizes (a check that the script runs)")
+    p.add_argument("--big-runs", type=int, default=10_000, help="runs of the largest batch (default 10⁴)")
+    p.add_argument("--compile-cost", action="store_true",
+                   help="also time the first call in a new process from an empty and from a filled numba cache")
+    args = p.parse_args(argv)
+    if args.repeat < 1 or args.big_runs < 1:
+        p.error("--repeat and --big-runs must be at least 1")
+    model, cores, cpus = machine()
+    rate = gemm_rate()
+    load0 = os.getloadavg()
+    print(f"Machine: {model}, {cores or '?'} physical cores, {cpus} logical CPUs; Python {platform.python_version()}, "
+          f"NumPy {np.__version__}; single-core GEMM {rate / 1e9:.1f} GFLOP/s; load average {load0[0]:.1f} at the start")
+    sizes = [(args.big_runs if runs == 10_000 else runs, steps) for runs, steps in (QUICK if args.quick else SIZES)]
+    longest = max(s for _, s in sizes)
+    sc = Scenario(duration_s=longest * 0.1, rms_window_s=(0.0, longest * 0.1))
+    truth = simulate_truth(sc.truth_model(maneuver=True), runs=max(r for r, _ in sizes), seed=0)
+    table = filters(sc)
+    t0 = time.perf_counter()
+    for est, *_ in table.values():  # first call: numba imported, kernels loaded from the cache (or compiled)
+        est.estimate(truth.y[:1, :2], truth.u[:1, :2], sc.xhat0, backend="numba")
+    print(f"First numba call of the five filters in this process (import, cache load or compilation): "
+          f"{time.perf_counter() - t0:.2f} s wall")
+    if args.compile_cost:
+        (c_cpu, c_wall), (w_cpu, w_wall) = first_call_cost()
+        print(f"First call of the five filters in a new process: empty cache (compilation) {c_cpu:.1f} s CPU "
+              f"({c_wall:.1f} s wall); filled cache {w_cpu:.2f} s CPU ({w_wall:.2f} s wall)")
+    print()
+    print("| filter | runs × steps | NumPy µs/step | numba µs/step | NumPy ÷ numba | filterpy µs/step | "
+          "filterpy ÷ numba | limit µs/step | numba Δ | filterpy Δ |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, (est, fp, kind, shared) in table.items():
+        for runs, steps in sizes:
+            y, u = truth.y[:runs, :steps], truth.u[:runs, :steps]
+
+            def run(backend, est=est, y=y, u=u):
+                return est.estimate(y, u, sc.xhat0, keep_covariance=False, backend=backend).xhat
+
+            t_np, ref = _min_time(lambda: run("numpy"), args.repeat)
+            t_nb, got = _min_time(lambda: run("numba"), args.repeat)
+            per = 1e6 / steps
+            cells = [f"{t_np * per:.1f}", f"{t_nb * per:.2f}", _ratio(t_np / t_nb)]
+            if fp is not None:
+                few = min(runs, 20)
+                t_fp, xs = _min_time(lambda fp=fp, few=few, y=y, u=u: fp(est, y[:few], u[:few], sc.xhat0),
+                                        max(1, args.repeat // 2) if few > 1 else args.repeat)
+                t_fp *= runs / few
+                cells += [f"{t_fp * per:.0f}", _ratio(t_fp / t_nb)]
+                d_fp = f"{_rel(ref[:few], xs):.0e}"
+            else:
+                cells += ["—", "—"]
+                d_fp = "—"
+            work = flops(kind) * runs + (flops("joseph") if shared else 0)
+            cells += [f"{work / rate * 1e6:.3f}", f"{_rel(ref, got):.0e}", d_fp]
+            print(f"| {name} | {runs} × {steps} | " + " | ".join(cells) + " |", flush=True)
+    print(f"\nload average {os.getloadavg()[0]:.1f} at the end; each cell the least of {args.repeat} CPU-time "
+          "timings of the whole batch divided by its steps (filterpy: of fewer, on at most 20 runs, scaled to the "
+          "runs); Δ: largest |x̂ − x̂_NumPy| over runs and steps, each state channel over its largest |x̂_NumPy|")
+
+
+if __name__ == "__main__":
+    main()

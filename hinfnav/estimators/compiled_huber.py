@@ -1,0 +1,320 @@
+"""Huber's M-estimation correction for the compiled kernels (numba; imported with :mod:`.compiled_kernels`).
+
+The same estimate as :func:`hinfnav.estimators.huber.huber_correct` (with a
+zero prior in error coordinates): the Kalman solution when every whitened
+residual is within gamma; else the Newton point in the measurement space
+(``huber.py``'s ``_minimise_measurement_space``) when it reproduces its split;
+else the whole whitened regression ``M = [L_R⁻¹ H; L_P⁻¹]`` minimised by the
+Newton/IRLS/backtracking iterations of
+:func:`hinfnav.estimators.huber_regression.minimise`.
+
+numba's on-disk cache checks only the file of the function it compiles: after editing
+this module, delete the kernels' cache (``__pycache__/compiled_*.nbi``/``.nbc`` or
+``NUMBA_CACHE_DIR``) or touch :mod:`hinfnav.estimators.compiled_kernels`.
+"""
+
+import numpy as np
+from numba import njit
+
+from .compiled_linalg import (chol, chol_solve, inv_to, lin, maxabs, mm, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
+                              tri_inv)
+
+__all__ = ["huber_to"]
+
+_BETAS = (0.0, 1e-1, 1e-2, 1e-3)  # as hinfnav.estimators.huber_regression.BETAS
+_N_BACKTRACK = 11  # BACKTRACK = 0.5 ** arange(11)
+
+
+@njit(cache=True, error_model="numpy")
+def _scaled_solve(A, b, usable):
+    """``A⁻¹ b`` by the Jacobi-scaled Cholesky factor (``_spd_solve``); ``(x, ok)``, x = 0 when not ok."""
+    n = A.shape[0]
+    s = np.empty(n)
+    x = np.zeros(n)
+    if not usable:
+        return x, False
+    for i in range(n):
+        d = A[i, i]
+        if not (np.isfinite(d) and d > 0.0):
+            return x, False
+        s[i] = 1.0 / np.sqrt(d)
+    As = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            As[i, j] = A[i, j] * s[i] * s[j]
+    L, ok = chol(As)
+    if not ok:
+        return x, False
+    rhs = np.empty((n, 1))
+    for i in range(n):
+        rhs[i, 0] = s[i] * b[i]
+    X = chol_solve(L, rhs)
+    for i in range(n):
+        x[i] = s[i] * X[i, 0]
+        if not np.isfinite(x[i]):
+            return np.zeros(n), False
+    return x, True
+
+
+@njit(cache=True, error_model="numpy")
+def _normal(M, w):
+    """Mᵀ diag(w) M."""
+    r, n = M.shape
+    A = np.zeros((n, n))
+    for k in range(r):
+        if w[k] != 0.0:
+            for i in range(n):
+                a = w[k] * M[k, i]
+                for j in range(n):
+                    A[i, j] += a * M[k, j]
+    return A
+
+
+@njit(cache=True, error_model="numpy")
+def _huber_cost(z, gamma):
+    c = 0.0
+    for v in z:
+        a = abs(v)
+        c += 0.5 * a * a if a <= gamma else gamma * a - 0.5 * gamma * gamma
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def _psi(z, gamma):
+    w = np.empty(z.size)
+    for i in range(z.size):
+        a = abs(z[i])
+        w[i] = 1.0 if a <= gamma else gamma / max(a, gamma)
+    return w
+
+
+@njit(cache=True, error_model="numpy")
+def _residual(M, x, yv):
+    """M x − y."""
+    z = mv(M, x)
+    for i in range(z.size):
+        z[i] -= yv[i]
+    return z
+
+
+@njit(cache=True, error_model="numpy")
+def _minimise(M, yv, x, gamma, tol, max_iter):
+    """:func:`hinfnav.estimators.huber_regression.minimise` for one regression; returns x."""
+    r, n = M.shape
+    MT = M.T.copy()
+    slack = 1e-12 * gamma
+    x = x.copy()
+    d = np.empty(r)
+    g = np.empty(r)
+    for _ in range(max_iter):
+        zeta = _residual(M, x, yv)
+        psi = _psi(zeta, gamma)
+        nq = 0
+        for i in range(r):
+            if abs(zeta[i]) <= gamma:
+                nq += 1
+                g[i] = zeta[i]
+            else:
+                g[i] = gamma * np.sign(zeta[i])
+        grad = mv(MT, g)
+        cands = np.empty((len(_BETAS), n))
+        exact = False
+        for b in range(len(_BETAS)):
+            beta = _BETAS[b]
+            for i in range(r):
+                d[i] = 1.0 if abs(zeta[i]) <= gamma else beta * psi[i]
+            dx, ok = _scaled_solve(_normal(M, d), grad, (nq >= n) if beta == 0.0 else True)
+            cands[b] = lin(1.0, x, -1.0, dx)
+            if beta == 0.0 and ok:
+                zc = _residual(M, cands[0], yv)
+                exact = True
+                for i in range(r):
+                    if abs(zeta[i]) <= gamma:
+                        if not abs(zc[i]) <= gamma + slack:
+                            exact = False
+                    elif not np.sign(zeta[i]) * zc[i] >= gamma - slack:
+                        exact = False
+                if exact:
+                    return cands[0]
+        # IRLS step (weights psi) and the backtracked Newton candidates: the cheapest is kept
+        for i in range(r):
+            g[i] = psi[i] * yv[i]
+        xn, _ = _scaled_solve(_normal(M, psi), mv(MT, g), True)
+        step = maxabs(mv(M, lin(1.0, xn, -1.0, x)))
+        best = xn
+        best_cost = _huber_cost(_residual(M, xn, yv), gamma)
+        for b in range(len(_BETAS)):
+            f = 1.0
+            for _t in range(_N_BACKTRACK):
+                trial = lin(1.0 - f, x, f, cands[b])
+                cost = _huber_cost(_residual(M, trial, yv), gamma)
+                if cost < best_cost:
+                    best, best_cost = trial, cost
+                f *= 0.5
+        x = best
+        if step <= tol:
+            break
+    return x
+
+
+@njit(cache=True, error_model="numpy")
+def _huber_general(P, A, e, dx, gamma, tol, max_iter):
+    """The whole whitened regression ``M = [A; L_P⁻¹]``, ``y = [e; 0]`` minimised from dx: ``(dx, P⁺, ok)``."""
+    m, n = A.shape
+    L_P, ok = chol(P)
+    if not ok:
+        return dx, P, False
+    M = np.empty((m + n, n))
+    M[:m] = A
+    M[m:] = tri_inv(L_P)
+    yv = np.zeros(m + n)
+    yv[:m] = e
+    dx = _minimise(M, yv, dx, gamma, tol, max_iter)
+    w = _psi(_residual(M, dx, yv), gamma)
+    Pp, ok = spd_inv(_normal(M, w))
+    return dx, Pp, ok
+
+
+@njit(cache=True, error_model="numpy")
+def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
+    """The first Newton point in the measurement space (huber.py's ``_minimise_measurement_space``).
+
+    From the Kalman point c, the Newton point of the current split of the
+    measurement rows with every prior row quadratic,
+    ``c − (g − E T⁻¹ E C g)`` (``g = c + ρ'(C c − e)``, ``E`` = 1 on the rows
+    within gamma and 0 beyond, ``T = I + E C E``); when it reproduces the split
+    and keeps every prior row ``L_Pᵀ Aᵀ c`` within gamma it is the minimiser:
+    ``δx = P Aᵀ c`` and ``P⁺ = P − U (E_w C E_w + I)⁻¹ Uᵀ`` (``U = P Aᵀ E_w``,
+    ``E_w = diag(√ψ)``) are written and True returned; otherwise False.
+    """
+    m = C.shape[0]
+    n = P.shape[0]
+    slack = 1e-12 * gamma
+    zm, grad, E = np.empty(m), np.empty(m), np.empty(m)
+    for i in range(m):
+        zm[i] = Cc[i] - e[i]
+        q = abs(zm[i]) <= gamma
+        grad[i] = c[i] + (zm[i] if q else gamma * np.sign(zm[i]))
+        E[i] = 1.0 if q else 0.0
+    T = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
+    Ti, ok = spd_inv(T)
+    if not ok:
+        return False
+    Cg = mv(C, grad)
+    for i in range(m):
+        Cg[i] *= E[i]
+    w = mv(Ti, Cg)
+    cand = np.empty(m)
+    for i in range(m):
+        cand[i] = c[i] - (grad[i] - E[i] * w[i])
+    zc = mv(C, cand)
+    for i in range(m):
+        zc[i] -= e[i]
+        if E[i] == 1.0:
+            if not abs(zc[i]) <= gamma + slack:
+                return False
+        elif not np.sign(zm[i]) * zc[i] >= gamma - slack:
+            return False
+    L_P, ok = chol(P)
+    if not ok:
+        return False
+    ATc = np.zeros(n)
+    for i in range(m):
+        for j in range(n):
+            ATc[j] += A[i, j] * cand[i]
+    for j in range(n):  # prior rows L_Pᵀ Aᵀ c: beyond gamma (weight < 1), the whole regression decides
+        s = 0.0
+        for k in range(j, n):
+            s += L_P[k, j] * ATc[k]
+        if not abs(s) <= gamma:
+            return False
+    psi = _psi(zc, gamma)
+    for i in range(m):
+        E[i] = np.sqrt(psi[i])
+        for j in range(m):
+            T[i, j] = 0.0
+    for i in range(m):
+        for j in range(m):
+            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
+    Ti, ok = spd_inv(T)
+    if not ok:
+        return False
+    U = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            U[i, j] = PAT[i, j] * E[j]
+    UT = mm(U, Ti)
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(m):
+                s += UT[i, k] * U[j, k]
+            Pp[i, j] = P[i, j] - s
+    sym(Pp)
+    mv_to(PAT, cand, dx)
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, Pp, dx):
+    """Huber's correction (huber_correct with x_prior 0) into Pp and dx; False if a factorisation fails.
+
+    The Kalman solution ``c = (C + I)⁻¹ e``, ``δx = P Aᵀ c`` first (C = A P Aᵀ,
+    e = L_R⁻¹ ν); when every whitened residual, measurement ``C c − e`` and prior
+    ``L_P⁻¹ δx``, is within gamma (the prior rows checked by ``cᵀ C c ≤ γ²``
+    first, as huber_correct does) it is the M-estimate; otherwise the whole
+    regression is minimised (:func:`_huber_general`).
+    """
+    n = P.shape[0]
+    m = A.shape[0]
+    mv_to(LRi, nu, e)
+    mmt_to(P, A, PAT)
+    mm_to(A, PAT, C)
+    sym(C)
+    for i in range(m):
+        C[i, i] += 1.0
+    ok = inv_to(C, Lm, Si)
+    for i in range(m):
+        C[i, i] -= 1.0
+    if not ok:
+        return False
+    mv_to(Si, e, c)
+    mv_to(PAT, c, dx)
+    mv_to(C, c, Cc)
+    inside = True
+    cCc = 0.0
+    for i in range(m):
+        cCc += c[i] * Cc[i]
+        if not abs(Cc[i] - e[i]) <= gamma:
+            inside = False
+    if inside and cCc > gamma * gamma:  # a prior row may be beyond gamma: L_P⁻¹ δx
+        L_P, ok = chol(P)
+        if not ok:
+            return False
+        z = dx.copy()
+        for i in range(n):
+            s = z[i]
+            for k in range(i):
+                s -= L_P[i, k] * z[k]
+            z[i] = s / L_P[i, i]
+            if not abs(z[i]) <= gamma:
+                inside = False
+    if not inside and _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
+        return True
+    if not inside:
+        dx2, Pp2, ok = _huber_general(P, A, e, dx.copy(), gamma, tol, max_iter)
+        Pp[:] = Pp2
+        dx[:] = dx2
+        return ok
+    mm_to(PAT, Si, KW)
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(m):
+                s += KW[i, k] * PAT[j, k]
+            Pp[i, j] = P[i, j] - s
+    sym(Pp)
+    return True
