@@ -45,14 +45,16 @@ NAMES = registered_estimators()
 
 #: The registered estimators that have a kernel on their scenario (a kernel lost by a refactoring fails here).
 WITH_KERNEL = {"ekf", "ekf_known_input", "recursive_hinf", "ekf_augmented_thrust", "ekf_augmented_thrust_st", "hbf",
-               "ukf"}
+               "ukf", "stekf"}
 #: ... and those that fall back: the LTI filters (already one vectorised recursion), the attitude filters
 #: (quaternion states), the rate-adaptive filter (data-dependent Q), the converted measurement (R from the
-#: reading) and Yang 2020's extended-state filters (their own hooks).
+#: reading), Yang 2020's extended-state filters (their own hooks), Huber x strong tracking on the EKF core (no kernel
+#: class yet), and the benchmark's generic filters on Shi 2018's range/angle reading (a kernel needs y = H x + D v).
 WITHOUT_KERNEL = {"published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                   "designed_observer_closed_loop", "aekf", "astekf", "aaekf", "ekf_augmented_thrust_adaptive",
                   "ekf_converted", "yang2020_alg1", "yang2020_alg2", "yang2020_alg2_ideal", "yang2020_alg2_skip",
-                  "yang2020_fused"}
+                  "yang2020_fused", "attitude_hbf", "attitude_ukf", "huber_stekf", "model_adaptive", "model_ekf",
+                  "model_hbf", "model_stekf", "model_ukf"}
 
 
 def _scenario(name):
