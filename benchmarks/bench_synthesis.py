@@ -2,7 +2,7 @@
 
 Prints, for every δ̄ of the sweep, the certified γ*, the solver's γ, the worst
 sampled H∞ norm, the solver wall time and the total time (with
-certification), for the default solver chain (Clarabel, then CVXOPT polish)
+certification), for the default solver chain (CVXOPT, Clarabel as fallback, no polish)
 and for each solver alone; then the time of the whole sweep. Both filter
 forms are run: ``general`` (LMI (20) as in the paper) and ``observer``
 (``C_F = −L``, ``A_F = A + B_F C`` imposed); a last table compares them

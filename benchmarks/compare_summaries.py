@@ -8,7 +8,7 @@ Prints every numeric leaf whose relative difference exceeds ``rtol`` (and keys
 present in one file only), then the largest relative difference; exits 1 if
 anything differs. Used to check that a refactoring leaves every reproduced
 number of ``python -m hinfnav reproduce --seed 0`` unchanged (issue 7: 1e-9).
-Fields that record time or provenance (``*_time_s``, ``provenance``) are skipped;
+Fields that record time or provenance (``*_time_s``, ``timing_s``, ``elapsed_s``, ``provenance``) are skipped;
 fields only in NEW are listed as added (a later version may add fields), fields
 only in OLD count as differences.
 """
@@ -18,7 +18,7 @@ import json
 import math
 import sys
 
-SKIP = ("time_s", "provenance", "generated")
+SKIP = ("time_s", "timing_s", "elapsed_s", "provenance", "generated")
 
 
 def leaves(obj, prefix=""):

@@ -41,7 +41,6 @@ REPRODUCE = (
     "tests/test_attitude2018_reproduce.py",
     "tests/test_outputs.py::test_interrupted_and_concurrent_reproduce_never_mix_two_runs",
     "tests/test_paper_notebooks.py::test_run_notebooks_executes_the_named_notebooks_into_the_folder",
-    "tests/test_reproduce_regression.py",
     "tests/test_reproduce_skeleton.py",
     "tests/test_shi2018_reproduce.py",
     "tests/test_sun2011_reproduce.py",

@@ -59,7 +59,7 @@ def test_noise_scaled_system_designs_and_certifies(random_uncertain):
 
 def test_paper_model_is_not_normalised(scenario):
     # the paper's designs keep their numbers: its block scales (noise 0.1, output 16 after the state scaling) are
-    # below the threshold (tests/test_reproduce_regression.py checks the numbers themselves to 1e-9)
+    # below the threshold (tests/test_sun2011_reproduce.py checks the numbers themselves to 1e-9)
     scales = block_scales(prepare(scenario.design_model(0.05), "diagonal", "balance"))
     assert scales == pytest.approx({"inputs": 0.1, "output": 16.0})
     assert max(scales.values()) < NORMALIZE_THRESHOLD / 2

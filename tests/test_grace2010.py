@@ -16,7 +16,7 @@ from hinfnav.papers.grace2010 import (
 )
 from hinfnav.papers.grace2010.dynamics import pair, rk4, two_body, two_body_j2
 from hinfnav.papers.grace2010.filters import build_filters, model_mismatch_moment
-from hinfnav.papers.grace2010.measurements import linear_form
+from hinfnav.papers.grace2010.measurements import VARIANTS, linear_form, shared_model_groups
 from hinfnav.papers.grace2010.studies import error_metrics, run_filter
 from hinfnav.systems.hill import hill_system
 
@@ -114,6 +114,26 @@ def test_ekf_on_real_day_beats_measurement_noise(data):
     m = error_metrics(xh, P, data.truth[:n], data.t[:n], data.period_s)
     assert max(m["rms_per_axis"][:3]) < 0.8
     assert np.isfinite(m["nees"])
+
+
+def test_gnss_variants_batched_equal_their_own_runs(data):
+    # the reproduce runs the GNSS variants as one batch (shared_model_groups); reference: each variant run
+    # alone (independent computation), over the first 400 epochs (a dropout block included); 1e-9 relative
+    n = 400
+    sets = {v: make_measurements(data, v, seed=0) for v in VARIANTS}
+    groups = shared_model_groups(sets)
+    assert groups == [["kband_angles"], ["gnss", "gnss_outliers", "gnss_dropouts"]]
+    sets["gnss_dropouts"].available[100:130] = False  # a dropout within the short run
+    one = one_step_mismatch(data)
+    built = build_filters(data, sets["gnss"].model, linear_form(sets["gnss"])[1], one["Q_mismatch"], one["Q_mismatch"])
+    for name in ("ekf_hill", "adaptive_hill_accel"):
+        est, _ = built[name]
+        xh, P = run_filter(est, np.stack([sets[v].y[:n] for v in groups[1]]),
+                           np.stack([sets[v].available[:n] for v in groups[1]]), data.truth[0])
+        for i, v in enumerate(groups[1]):
+            x1, P1 = run_filter(est, sets[v].y[:n], sets[v].available[:n], data.truth[0])
+            np.testing.assert_allclose(xh[i], x1, rtol=1e-9, atol=1e-9 * np.abs(x1).max())
+            np.testing.assert_allclose(P[i], P1, rtol=1e-9, atol=1e-9 * np.abs(P1).max())
 
 
 def test_vendored_files_equal_the_published_ones(data):

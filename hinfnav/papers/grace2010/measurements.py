@@ -49,7 +49,8 @@ from .constants import (
     OUTLIER_SCALE,
 )
 
-__all__ = ["VARIANTS", "DROPOUT_BLOCK", "MeasurementSet", "kband_noise", "make_measurements", "linear_form"]
+__all__ = ["VARIANTS", "DROPOUT_BLOCK", "MeasurementSet", "kband_noise", "make_measurements", "linear_form",
+           "shared_model_groups"]
 
 VARIANTS = ("kband_angles", "gnss", "gnss_outliers", "gnss_dropouts")
 #: Length of one dropout block, epochs.
@@ -145,3 +146,22 @@ def linear_form(mset):
         return mset.y, mset.model
     R = ConvertedPosition(mset.model).noise_covariance(mset.y.mean(axis=0))
     return position_from_range_angles(mset.y), position_measurement(np.linalg.cholesky(R))
+
+
+def shared_model_groups(sets):
+    """The variants (name → :class:`MeasurementSet`) grouped by measurement model, in their order.
+
+    Variants whose models are linear with equal H and R (the GNSS ones) form one group: the filters built
+    for one of them are those of every one, so they run as one batch; any other variant is a group alone.
+    """
+    groups = []
+    for name, ms in sets.items():
+        for group in groups:
+            m0 = sets[group[0]].model
+            if (isinstance(ms.model, LinearMeasurement) and isinstance(m0, LinearMeasurement)
+                    and np.array_equal(ms.model.H, m0.H) and np.array_equal(ms.model.R, m0.R)):
+                group.append(name)
+                break
+        else:
+            groups.append([name])
+    return groups

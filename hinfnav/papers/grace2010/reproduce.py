@@ -24,7 +24,7 @@ from .filters import (
     lmi_designs,
     model_mismatch_moment,
 )
-from .measurements import VARIANTS, kband_noise, linear_form, make_measurements
+from .measurements import VARIANTS, kband_noise, linear_form, make_measurements, shared_model_groups
 from .mismatch import chief_rate_range, one_step_mismatch, propagation_errors
 from .studies import SETTLE_S, error_metrics, run_filter
 
@@ -71,30 +71,34 @@ def run_study(data, *, variants=VARIANTS, seed=0, filters=FILTER_NAMES, design_d
     truth, t = data.truth[:n], data.t[:n]
     rng = np.random.default_rng(as_seed("seed", seed))
     x0 = truth[0] + P0_STD * rng.standard_normal(6)
-    table, errors = {}, {}
     t0 = time.perf_counter()
-    for variant in variants:
-        ms = make_measurements(data, variant, seed=seed)
-        y_lin, lin = linear_form(ms)
-        built = build_filters(data, ms.model, lin, Q_hill, Q_j2, use)
-        table[variant] = {"notes": ms.notes, "filters": {}}
-        errors[variant] = {}
+    sets = {variant: make_measurements(data, variant, seed=seed) for variant in variants}
+    table = {v: {"notes": ms.notes, "filters": {}} for v, ms in sets.items()}
+    errors = {v: {} for v in sets}
+    for group in shared_model_groups(sets):
+        # the variants of one linear measurement model (the GNSS ones) share their filters: one batched pass each
+        ms0 = sets[group[0]]
+        built = build_filters(data, ms0.model, linear_form(ms0)[1], Q_hill, Q_j2, use)
         for name in filters:
             if name not in built:
-                table[variant]["filters"][name] = {"error": "not run: no design (designs=False, or the design failed: see designs)"}
+                for variant in group:
+                    table[variant]["filters"][name] = {
+                        "error": "not run: no design (designs=False, or the design failed: see designs)"}
                 continue
             est, form = built[name]
-            xh, P = run_filter(est, (ms.y if form == "direct" else y_lin)[:n], ms.available[:n], x0)
-            row = error_metrics(xh, P, truth, t, data.period_s)
-            row["measurement_form"] = "range/angles" if (form == "direct" and variant == "kband_angles") else "position"
-            key = {"robust_lmi_hill": "robust", "mixed_h2hinf_hill": "mixed"}.get(name)
-            if key:
-                row["certified_gamma"] = use[key]["gamma"]
-            if name == "recursive_hinf_hill":
-                row["theta"] = est.theta
-            table[variant]["filters"][name] = row
-            if keep_errors:
-                errors[variant][name] = xh - truth
+            ys = np.stack([(sets[v].y if form == "direct" else linear_form(sets[v])[0])[:n] for v in group])
+            xh, P = run_filter(est, ys, np.stack([sets[v].available[:n] for v in group]), x0)
+            for i, variant in enumerate(group):
+                row = error_metrics(xh[i], None if P is None else P[i], truth, t, data.period_s)
+                row["measurement_form"] = "range/angles" if (form == "direct" and variant == "kband_angles") else "position"
+                key = {"robust_lmi_hill": "robust", "mixed_h2hinf_hill": "mixed"}.get(name)
+                if key:
+                    row["certified_gamma"] = use[key]["gamma"]
+                if name == "recursive_hinf_hill":
+                    row["theta"] = est.theta
+                table[variant]["filters"][name] = row
+                if keep_errors:
+                    errors[variant][name] = xh[i] - truth
     timings["filters_s"] = time.perf_counter() - t0
     design_info = {}
     for label, dd in designs.items():

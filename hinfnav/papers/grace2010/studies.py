@@ -26,15 +26,23 @@ def run_filter(est, y, available, x0, P0=None):
 
     An unavailable reading is a missing one (``missing="skip"``): the Kalman-type filters skip the
     update there, the fixed-gain filters (LTI, recursive H∞) are given the reading they predict.
+    Several variants of the day's readings under one measurement model run as one batch: ``y`` (runs, n, m)
+    and ``available`` (runs, n) give ``xhat`` (runs, n, 6) and ``P`` (runs, n, 6, 6) (the runs are
+    independent in the batched filters: each run's numbers are its own pass's, to rounding).
     """
     y = np.asarray(y, float)
     available = np.asarray(available, bool)
-    if y.ndim != 2 or available.shape != (y.shape[0],):
-        raise InputError(f"y must be (n, m) and available (n,); got {y.shape} and {available.shape}")
-    n = y.shape[0]
+    one = y.ndim == 2
+    if one:
+        y, available = y[None], available[None]
+    if y.ndim != 3 or available.shape != y.shape[:2]:
+        raise InputError(f"y must be (n, m) or (runs, n, m) and available (n,) or (runs, n); got {np.shape(y)} and "
+                         f"{np.shape(available)}")
+    runs, n = y.shape[:2]
     est.missing = "skip"
-    hist = est.estimate(np.where(available[:, None], y, np.nan)[None], np.zeros((1, n, est.n_input)), x0, P0)
-    return hist.xhat[0], (None if hist.P is None else np.asarray(hist.P[0]))
+    hist = est.estimate(np.where(available[..., None], y, np.nan), np.zeros((runs, n, est.n_input)), x0, P0)
+    P = None if hist.P is None else np.asarray(hist.P)
+    return (hist.xhat[0], None if P is None else P[0]) if one else (hist.xhat, P)
 
 
 def nees(error, P, t, settle_s=SETTLE_S):
