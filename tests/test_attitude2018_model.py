@@ -167,3 +167,21 @@ def test_bad_inputs_name_the_parameter():
         AttitudeSystem(-np.eye(3), 1.0)
     with pytest.raises(InputError, match="orbits"):
         Scenario(orbits=-1.0)
+
+
+def test_model_functions_do_not_depend_on_the_batch():
+    # identity (same computation): a run's mean prediction, measurement, Jacobians and correction are bitwise
+    # the same alone and in a batch (a 2-D `a @ B` rounds differently for one row than for several)
+    sc = Scenario()
+    sysm, meas = sc.system(), sc.measurement
+    rng = np.random.default_rng(5)
+    x = np.concatenate([rng.normal(size=(7, 4)), 1e-4 * rng.normal(size=(7, 3)), 1e-5 * rng.normal(size=(7, 3))], axis=1)
+    x[:, :4] /= np.linalg.norm(x[:, :4], axis=1, keepdims=True)
+    u, dx = 1e-5 * rng.normal(size=(7, 3)), 1e-4 * rng.normal(size=(7, 9))
+    maps = {"predict_mean": lambda s: sysm.predict_mean(x[s], u[s]), "step": lambda s: sysm.step(x[s], u[s]),
+            "transition": lambda s: sysm.transition(x[s]), "inject": lambda s: sysm.inject(x[s], dx[s]),
+            "function": lambda s: meas.function(x[s]), "error_jacobian": lambda s: meas.error_jacobian(x[s])}
+    for name, f in maps.items():
+        whole = f(slice(None))
+        for r in (0, 6):
+            np.testing.assert_array_equal(f(slice(r, r + 1))[0], whole[r], err_msg=name)

@@ -84,17 +84,28 @@ _CROSS_MAT = -_EPS.transpose(2, 0, 1).reshape(3, 9)  # v (3) -> [v×] (9)
 _CROSS = _EPS.reshape(3, 9).T.copy()  # (a ⊗ b) (9) -> a × b (3)
 
 
+def _rows(a, B):
+    """``a @ B`` for a batch of row vectors ``a`` (..., k) and one matrix ``B`` (k, m), row by row.
+
+    ``a @ B`` on a 2-D ``a`` is one BLAS call whose kernel (matrix-vector for
+    one row, matrix-matrix for several) and hence rounding depend on the number
+    of rows: a run's numbers would depend on which runs share its batch.
+    Each row here is the same sum of products whatever the batch.
+    """
+    return np.einsum("...k,km->...m", a, B)
+
+
 def cross_matrix(v):
     """``[v×]`` such that ``[v×] w = v × w``; shape (..., 3, 3)."""
     v = np.asarray(v, dtype=float)
-    return (v @ _CROSS_MAT).reshape(v.shape[:-1] + (3, 3))
+    return _rows(v, _CROSS_MAT).reshape(v.shape[:-1] + (3, 3))
 
 
 def cross(a, b):
     """``a × b`` for batches (faster than :func:`numpy.cross` on small vectors)."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     outer = a[..., :, None] * b[..., None, :]
-    return outer.reshape(outer.shape[:-2] + (9,)) @ _CROSS
+    return _rows(outer.reshape(outer.shape[:-2] + (9,)), _CROSS)
 
 
 def _quat_multiply_reference(p, q):
@@ -148,7 +159,7 @@ def _outer12(w, q):
 
 def quat_multiply(p, q):
     """``p ⊗ q`` of (A2), scalar last, so that ``A(p ⊗ q) = A(p) A(q)``."""
-    return _outer16(np.asarray(p, dtype=float), np.asarray(q, dtype=float)) @ _QPROD
+    return _rows(_outer16(np.asarray(p, dtype=float), np.asarray(q, dtype=float)), _QPROD)
 
 
 def quat_conjugate(q):
@@ -187,7 +198,7 @@ def rotvec_from_quat(q):
 def attitude_matrix(q):
     """``A(q)`` of (A1), reference (orbital) frame → body frame; shape (..., 3, 3)."""
     q = np.asarray(q, dtype=float)
-    return (_outer16(q, q) @ _ATT_FLAT).reshape(q.shape[:-1] + (3, 3))
+    return _rows(_outer16(q, q), _ATT_FLAT).reshape(q.shape[:-1] + (3, 3))
 
 
 def omega_matrix(w):
@@ -340,12 +351,12 @@ class AttitudeSystem:
 
     def rate_derivative(self, w, torque):
         """``ω̇ = J⁻¹(−ω × (J ω + h) + torque)`` of (A4) for a batch, rad/s²."""
-        Hm = w @ self.J.T + self.h
-        return (torque - cross(w, Hm)) @ self.J_inv.T
+        Hm = _rows(w, self.J.T) + self.h
+        return _rows(torque - cross(w, Hm), self.J_inv.T)
 
     def _derivative(self, q, w, torque):
         # q̇ = ½ [ω; 0] ⊗ q (A3): the product tensor's rows with p4 = 0
-        qdot = 0.5 * _outer12(w, q) @ _QPROD[:12]
+        qdot = 0.5 * _rows(_outer12(w, q), _QPROD[:12])
         return qdot, self.rate_derivative(w, torque)
 
     def step(self, x, u=None, w=None, t=0.0):
@@ -416,7 +427,7 @@ class AttitudeSystem:
         """
         w = np.asarray(x, dtype=float)[..., RATE]
         F0, F1 = self._F_affine
-        return (F0 + w @ F1).reshape(w.shape[:-1] + (9, 9))
+        return (F0 + _rows(w, F1)).reshape(w.shape[:-1] + (9, 9))
 
     def transition(self, x, order=3):
         """``Φ = e^{F Δt}`` by its Taylor series to ``order`` (‖FΔt‖ ≪ 1 here), shape (runs, 9, 9).
@@ -490,7 +501,7 @@ class StarSensorVectors(MeasurementModel):
     def function(self, x):
         x = self.check_state(x)
         q = x[..., QUAT]
-        return _outer16(q, q) @ self._body
+        return _rows(_outer16(q, q), self._body)
 
     def jacobian(self, x):
         """``∂h/∂x`` with respect to the 10 stored components, shape (..., 3k, 10) (zero for ω, T)."""
@@ -513,5 +524,5 @@ class StarSensorVectors(MeasurementModel):
         b = self.function(x)
         m = b.shape[-1]
         out = np.zeros(b.shape[:-1] + (m, 9))
-        out[..., :, :3] = (b @ self._hmap).reshape(b.shape[:-1] + (m, 3))
+        out[..., :, :3] = _rows(b, self._hmap).reshape(b.shape[:-1] + (m, 3))
         return out
