@@ -56,7 +56,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Sink", "HistorySink", "run_monte_carlo", "truth_batch", "truth_batches", "estimate_on_truth",
            "closed_loop_batch", "truth_runs", "resolve_estimator", "resolve_estimators", "check_measurement_match", "plain_seed",
-           "results_from_parts"]
+           "results_from_parts", "batch_result"]
 
 
 class Sink:
@@ -318,12 +318,14 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
                     for off, hist in estimate_on_truth(est, truth, xhat0, P0=P0, keep_covariance=keep_covariance,
                                                        diagnostics=diagnostics, max_bytes=max_bytes):
                         sink.add(name, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist)
+                        del hist
                 bar.update(truth.x.shape[0])
+                del truth  # before the next batch is simulated: the memory of one batch
             return sink.result()
         n1 = model.n_steps + 1
         for start in range(0, runs, batch_size):
             n = min(batch_size, runs - start)
-            w, v = draw_noise(w_model, v_model, child_rngs(seed, start + n)[start:], n1, model.system.n_noise,
+            w, v = draw_noise(w_model, v_model, child_rngs(seed, n, start), n1, model.system.n_noise,
                               model.measurement.n_noise)
             for name, est in ests.items():
                 truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0, keep_covariance=keep_covariance,
@@ -332,6 +334,8 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
                                 seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
                                 feedback=getattr(law, "source", "estimate"))
                 sink.add(name, start, replace(truth, settings=settings), hist)
+                del truth, hist
+            del w, v  # before the next batch is drawn: the memory of one batch
             bar.update(n)
     return sink.result()
 
@@ -374,6 +378,13 @@ def results_from_parts(parts: Sequence[SimulationResult], runs: int) -> Simulati
                             diagnostics=diag, xhat0=first.xhat0)
 
 
+def batch_result(name: str, truth: Truth, history: EstimateHistory, xhat0: ArrayLike) -> SimulationResult:
+    """The :class:`SimulationResult` of one batch that a sink receives (``settings["filter"]`` = ``name``)."""
+    return SimulationResult(t=truth.t, x=truth.x, xhat=history.xhat, u=truth.u, y=truth.y, P=history.P,
+                            settings=dict(truth.settings, filter=name), state=truth.state,
+                            diagnostics=history.diagnostics, xhat0=np.asarray(xhat0, dtype=float))
+
+
 class HistorySink(Sink):
     """Keeps every history: ``result()`` is name → :class:`SimulationResult` of all runs.
 
@@ -391,10 +402,7 @@ class HistorySink(Sink):
         self.parts: dict[str, list[SimulationResult]] = {}
 
     def add(self, name: str, start: int, truth: Truth, history: EstimateHistory) -> None:
-        settings = dict(truth.settings, filter=name)
-        self.parts.setdefault(name, []).append(SimulationResult(
-            t=truth.t, x=truth.x, xhat=history.xhat, u=truth.u, y=truth.y, P=history.P, settings=settings,
-            state=truth.state, diagnostics=history.diagnostics, xhat0=self.xhat0))
+        self.parts.setdefault(name, []).append(batch_result(name, truth, history, self.xhat0))
 
     def result(self) -> dict[str, SimulationResult]:
         return {name: results_from_parts(parts, self.runs) for name, parts in self.parts.items()}
