@@ -33,6 +33,7 @@ draws from its own child generator, and the batches are those of the spec's
 from __future__ import annotations
 
 import contextlib
+from collections import defaultdict
 import importlib
 import json
 import logging
@@ -49,9 +50,9 @@ from ..core.outputs import MARKER, check_output_dir, output_lock, to_json
 from ..core.progress import bar_disabled
 from ..core.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
-from ..metrics.accumulator import StatisticsAccumulator, add_batch
+from ..metrics.accumulator import StatisticsSink
 from ..metrics.consistency import NIS_KEYS, warn_if_diverged
-from ..sim.engine import estimate_on_truth, truth_batches, truth_runs
+from ..sim.engine import run_monte_carlo
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
 from .table import results_table
@@ -142,41 +143,22 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     scenario = _scenario(unit["scenario"], unit["settings"])
     runs, bs = unit["runs"], unit["batch_size"]
     cells = unit["cells"]
-    estimators, accs, errors = {}, {}, {}
-    elapsed, cpu = dict.fromkeys((c["cell_id"] for c in cells), 0.0), dict.fromkeys((c["cell_id"] for c in cells), 0.0)
+    estimators = {}
+    sink = _UnitSink(unit["windows"], runs, scenario.xhat0, unit["tol"])
     for c in cells:
         t0, c0 = time.perf_counter(), time.process_time()
         try:
             estimators[c["cell_id"]] = _estimator(scenario, unit["scenario"], unit["settings"], c["estimator"],
                                                   c["options"])
-            accs[c["cell_id"]] = StatisticsAccumulator(unit["windows"], runs, unit["tol"])
         except Exception as exc:
-            errors[c["cell_id"]] = f"{type(exc).__name__}: {exc}"
-        elapsed[c["cell_id"]] += time.perf_counter() - t0
-        cpu[c["cell_id"]] += time.process_time() - c0
-    truth_s = truth_cpu = 0.0
-    batches = truth_batches(scenario, unit["conditions"], runs=runs, batch_size=bs, seed=unit["seed"],
-                            noise=unit["noise"])
-    while True:  # the engine's open loop, with each cell's failures and time kept apart
-        t0, c0 = time.perf_counter(), time.process_time()
-        batch = next(batches, None)
-        truth_s += time.perf_counter() - t0
-        truth_cpu += time.process_time() - c0
-        if batch is None:
-            break
-        start, truth = batch
-        for c in cells:
-            cid = c["cell_id"]
-            if cid in errors:
-                continue
-            t0, c0 = time.perf_counter(), time.process_time()
-            try:
-                _run_cell_batch(estimators[cid], truth, scenario.xhat0, accs[cid], start)
-            except Exception as exc:
-                errors[cid] = f"{type(exc).__name__}: {exc}"
-            elapsed[cid] += time.perf_counter() - t0
-            cpu[cid] += time.process_time() - c0
-        del truth, batch
+            sink.fail(c["cell_id"], exc)
+        sink.timed(c["cell_id"], time.perf_counter() - t0, time.process_time() - c0)
+    if estimators:  # the engine's open loop; each cell's failures and time kept apart by the sink
+        run_monte_carlo(scenario, estimators, sink=sink, runs=runs, seed=unit["seed"], batch_size=bs,
+                        noise=unit["noise"], keep_covariance=True, diagnostics=NIS_KEYS, max_bytes=CONSISTENCY_BYTES,
+                        **unit["conditions"])
+    errors, elapsed, cpu, accs = sink.errors, sink.elapsed, sink.cpu, sink.accumulators
+    truth_s, truth_cpu = sink.truth_s, sink.truth_cpu
     out = []
     for c in cells:
         cid = c["cell_id"]
@@ -195,13 +177,25 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _run_cell_batch(est, truth, xhat0, acc, start):
-    """Run one estimator on one truth batch into the cell's accumulator (the engine's
-    :func:`~hinfnav.sim.engine.estimate_on_truth`, in chunks of runs whose histories fit :data:`CONSISTENCY_BYTES`)."""
-    for off, hist in estimate_on_truth(est, truth, xhat0, keep_covariance=True, diagnostics=NIS_KEYS,
-                                       max_bytes=CONSISTENCY_BYTES):
-        add_batch(acc, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist, xhat0)
-        del hist
+class _UnitSink(StatisticsSink):
+    """The engine's statistics sink of one task: also each cell's error (the cell then stops, the others go on)
+    and its wall and CPU seconds, and the seconds spent on the truth."""
+
+    def __init__(self, windows, runs, xhat0, tol):
+        super().__init__(windows, runs, xhat0, tol)
+        self.errors, self.elapsed, self.cpu = {}, defaultdict(float), defaultdict(float)
+        self.truth_s = self.truth_cpu = 0.0
+
+    def fail(self, name, exc):
+        self.errors[name] = f"{type(exc).__name__}: {exc}"
+
+    def timed(self, name, wall_s, cpu_s):
+        if name is None:
+            self.truth_s += wall_s
+            self.truth_cpu += cpu_s
+        else:
+            self.elapsed[name] += wall_s
+            self.cpu[name] += cpu_s
 
 
 class CellResults(tuple):

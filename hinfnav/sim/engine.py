@@ -25,7 +25,10 @@ is simulated by :func:`~hinfnav.sim.truth.simulate_truth` (linear systems in
 closed form per step, nonlinear ones by their ``step``).
 
 A *sink* receives every batch: ``add(name, start, truth, history)`` and
-``result()``. :class:`HistorySink` keeps the histories
+``result()``; ``fail(name, exc)`` when an estimator raises (re-raised unless
+the sink records it, as a campaign cell does: that estimator then stops) and
+``timed(name, wall_s, cpu_s)`` the time of each batch (``name=None``: the
+truth). :class:`HistorySink` keeps the histories
 (:class:`~hinfnav.sim.montecarlo.SimulationResult` per estimator);
 :class:`hinfnav.metrics.StatisticsSink` keeps streaming statistics only (memory
 of one batch, whatever the runs).
@@ -33,6 +36,7 @@ of one batch, whatever the runs).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
@@ -71,6 +75,15 @@ class Sink:
         """What the Monte Carlo returns."""
         raise NotImplementedError
 
+    def fail(self, name: str, exc: Exception) -> None:
+        """Estimator ``name`` raised ``exc`` on a batch (or this sink did, adding it): re-raised by default; a sink
+        that records it and returns (a campaign's cell) gets no more batches of ``name``."""
+        raise exc
+
+    def timed(self, name: str | None, wall_s: float, cpu_s: float) -> None:
+        """Wall and CPU seconds the engine spent on one batch of estimator ``name`` (its :meth:`add` included) or,
+        with ``name=None``, on simulating one truth batch (ignored by default)."""
+
 
 def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int | np.random.SeedSequence:
     """The seed as the engine keeps it: a Generator is drawn from once, so that every batch agrees."""
@@ -81,7 +94,8 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
 
 
 def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: Any) -> Estimator:
-    """An :class:`Estimator`: given, registered under a name for ``scenario``, or built from a design.
+    """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a
+    name for ``scenario``, or built from a design.
 
     A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
     the scenario's ``estimator_from_design`` (which checks that it was
@@ -95,16 +109,21 @@ def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: An
         return scenario.estimator_from_design(estimator)
     if estimator is None:
         raise InputError("estimator must be given (an Estimator or a registered filter name such as 'published')")
-    if not isinstance(estimator, Estimator):
+    if not _estimator_like(estimator):
         raise InputError(f"estimator must be a hinfnav Estimator or a filter name; got {type(estimator).__name__}")
     return estimator
+
+
+def _estimator_like(obj: Any) -> bool:
+    """An Estimator, or an object with what the open loop calls (``estimate`` and ``measurement``, such as a wrapper)."""
+    return isinstance(obj, Estimator) or (callable(getattr(obj, "estimate", None)) and hasattr(obj, "measurement"))
 
 
 def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
     """Name → Estimator from one estimator, a sequence of them, or a mapping name → estimator (names unique)."""
     if isinstance(estimators, Mapping):
         items = [(str(k), v) for k, v in estimators.items()]
-    elif isinstance(estimators, (str, Estimator, SynthesisResult)) or estimators is None:
+    elif isinstance(estimators, (str, SynthesisResult)) or estimators is None or _estimator_like(estimators):
         items = [(None, estimators)]
     else:
         items = [(None, e) for e in estimators]
@@ -113,7 +132,7 @@ def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
     out = {}
     for key, e in items:
         est = resolve_estimator(e, scenario)
-        name = est.name if key is None else key
+        name = getattr(est, "name", type(est).__name__) if key is None else key
         if name in out:
             raise InputError(f"estimators: the name {name!r} is given twice; pass a mapping name -> estimator")
         out[name] = est
@@ -311,16 +330,32 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
         w_model, v_model = noise_models(noise, measurement_noise, model.system.dt)
     desc = ", ".join(ests) + (" (closed loop)" if loop else "")
     with tqdm(total=runs, disable=bar_disabled(progress), desc=desc, unit="run") as bar:
+        failed = set()  # estimators whose failure the sink recorded: run no more
         if not loop:
-            for start, truth in truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed,
-                                              noise=noise, measurement_noise=measurement_noise):
+            batches = truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed, noise=noise,
+                                    measurement_noise=measurement_noise)
+            while True:
+                t0, c0 = time.perf_counter(), time.process_time()
+                batch = next(batches, None)
+                sink.timed(None, time.perf_counter() - t0, time.process_time() - c0)
+                if batch is None:
+                    break
+                start, truth = batch
                 for name, est in ests.items():
-                    for off, hist in estimate_on_truth(est, truth, xhat0, P0=P0, keep_covariance=keep_covariance,
-                                                       diagnostics=diagnostics, max_bytes=max_bytes):
-                        sink.add(name, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist)
-                        del hist
+                    if name in failed:
+                        continue
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    try:
+                        for off, hist in estimate_on_truth(est, truth, xhat0, P0=P0, keep_covariance=keep_covariance,
+                                                           diagnostics=diagnostics, max_bytes=max_bytes):
+                            sink.add(name, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist)
+                            del hist
+                    except Exception as exc:
+                        failed.add(name)
+                        sink.fail(name, exc)
+                    sink.timed(name, time.perf_counter() - t0, time.process_time() - c0)
                 bar.update(truth.x.shape[0])
-                del truth  # before the next batch is simulated: the memory of one batch
+                del truth, batch  # before the next batch is simulated: the memory of one batch
             return sink.result()
         n1 = model.n_steps + 1
         for start in range(0, runs, batch_size):
@@ -328,13 +363,21 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
             w, v = draw_noise(w_model, v_model, child_rngs(seed, n, start), n1, model.system.n_noise,
                               model.measurement.n_noise)
             for name, est in ests.items():
-                truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0, keep_covariance=keep_covariance,
-                                                diagnostics=diagnostics)
-                settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
-                                seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
-                                feedback=getattr(law, "source", "estimate"))
-                sink.add(name, start, replace(truth, settings=settings), hist)
-                del truth, hist
+                if name in failed:
+                    continue
+                t0, c0 = time.perf_counter(), time.process_time()
+                try:
+                    truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0,
+                                                    keep_covariance=keep_covariance, diagnostics=diagnostics)
+                    settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
+                                    seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
+                                    feedback=getattr(law, "source", "estimate"))
+                    sink.add(name, start, replace(truth, settings=settings), hist)
+                    del truth, hist
+                except Exception as exc:
+                    failed.add(name)
+                    sink.fail(name, exc)
+                sink.timed(name, time.perf_counter() - t0, time.process_time() - c0)
             del w, v  # before the next batch is drawn: the memory of one batch
             bar.update(n)
     return sink.result()
