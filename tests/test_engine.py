@@ -95,3 +95,45 @@ def test_memory_does_not_grow_with_runs_without_histories():
     assert large < 1.1 * small, (small, large)
     kept = _peak_bytes(200, HistorySink(SUN.xhat0, 200))
     assert kept > 5 * small, (small, kept)
+
+
+class _Failing:
+    """An estimator (duck-typed, as a campaign may wrap one) that raises on its second batch."""
+
+    def __init__(self, inner):
+        self.inner, self.measurement, self.name, self.calls = inner, inner.measurement, "failing", 0
+
+    def estimate(self, *args, **kwargs):
+        self.calls += 1
+        if self.calls == 2:
+            raise FloatingPointError("blown up on purpose")
+        return self.inner.estimate(*args, **kwargs)
+
+
+class _Recording(HistorySink):
+    def __init__(self, xhat0, runs):
+        super().__init__(xhat0, runs)
+        self.errors, self.seconds = {}, {}
+
+    def fail(self, name, exc):
+        self.errors[name] = exc
+
+    def timed(self, name, wall_s, cpu_s):
+        self.seconds.setdefault(name, []).append((wall_s, cpu_s))
+
+
+def test_a_failing_estimator_stops_alone_when_the_sink_records_it():
+    from hinfnav import make_estimator
+    failing = _Failing(make_estimator("ekf", SUN))
+    sink = _Recording(SUN.xhat0, 6)
+    out = run_monte_carlo(SUN, {"failing": failing, "published": "published"}, sink=sink, runs=6, seed=2,
+                          batch_size=2, keep_covariance=False, maneuver=True)
+    # batches of 2 runs: the failing one ran its first batch, raised on the second and got no third
+    assert failing.calls == 2 and isinstance(sink.errors["failing"], FloatingPointError)
+    assert out["published"].x.shape[0] == 6 and out["failing"].x.shape[0] == 2
+    assert len(sink.seconds[None]) == 4 and len(sink.seconds["published"]) == 3 and len(sink.seconds["failing"]) == 2
+    assert all(w >= 0 and c >= 0 for w, c in sink.seconds["published"])
+    # the default sink re-raises
+    with pytest.raises(FloatingPointError, match="on purpose"):
+        failing.calls = 1
+        run_monte_carlo(SUN, failing, sink=HistorySink(SUN.xhat0, 2), runs=2, seed=2, maneuver=True)
