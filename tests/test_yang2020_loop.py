@@ -88,16 +88,20 @@ def test_passive_filters_shapes(loop):
 
 
 def test_batched_variants_equal_their_own_loops(loop):
-    # run_closed_loops steps several controllers as rows of one batch; each variant must give the numbers of its
-    # own run_closed_loop (the reference: the loop run alone), round-off aside, whatever the other rows do
-    sc_i = replace(SC, integral="dt")
-    batched = run_closed_loops([(SC, "adrc"), (SC, "pid"), (sc_i, "adrc")], runs=2, seed=11,
-                               passive=(True, False, False))
+    # run_closed_loops steps several loops as rows of one batch (controllers, integral readings, and noise/omega_d
+    # readings, each with its own estimator); each variant must give the numbers of its own run_closed_loop (the
+    # reference: the loop run alone), round-off aside, whatever the other rows do
+    sc_i, sc_n, sc_w = replace(SC, integral="dt"), replace(SC, noise="two_sided"), replace(SC, omega_d="rad_s")
+    others = ((SC, "pid"), (sc_n, "adrc"), (sc_i, "adrc"), (sc_w, "pid"))
+    batched = run_closed_loops([(SC, "adrc"), *others], runs=2, seed=11, passive=(True, False, False, False, False))
     assert _same(batched[0].x, loop.x) and _same(batched[0].xhat, loop.xhat)
     assert _same(batched[0].passive["L1"], loop.passive["L1"]) and batched[1].passive == {}
-    for res, (sc, kind) in zip(batched[1:], ((SC, "pid"), (sc_i, "adrc"))):
+    for res, (sc, kind) in zip(batched[1:], others):
         alone = run_closed_loop(sc, controller=kind, runs=2, seed=11, passive=False)
-        assert _same(res.x, alone.x) and _same(res.u, alone.u)
-        assert res.settings["clipped_input_steps"] == alone.settings["clipped_input_steps"]
+        assert _same(res.x, alone.x) and _same(res.u, alone.u) and _same(res.xhat, alone.xhat)
+        np.testing.assert_array_equal(res.f, alone.f)
+        assert res.settings == alone.settings
     with pytest.raises(InputError, match="differs"):
-        run_closed_loops([(SC, "adrc"), (replace(SC, noise="two_sided"), "adrc")])
+        run_closed_loops([(SC, "adrc"), (replace(SC, timing="prior"), "adrc")])
+    with pytest.raises(InputError, match="first variant's readings"):
+        run_closed_loops([(SC, "adrc"), (sc_n, "adrc")], passive=(False, True))

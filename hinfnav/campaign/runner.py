@@ -33,6 +33,7 @@ draws from its own child generator, and the batches are those of the spec's
 from __future__ import annotations
 
 import contextlib
+from collections import defaultdict
 import importlib
 import json
 import logging
@@ -49,10 +50,9 @@ from ..io.outputs import MARKER, check_output_dir, output_lock, to_json
 from ..io.progress import bar_disabled
 from ..io.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
-from ..metrics.accumulator import StatisticsAccumulator, add_batch
+from ..metrics.accumulator import StatisticsSink
 from ..metrics.consistency import NIS_KEYS, warn_if_diverged
-from ..sim.engine import estimate_on_truth, truth_batch, truth_batches, truth_runs
-from ..sim.truth import child_rngs
+from ..sim.engine import run_monte_carlo, truth_batch
 from .registry import build_scenario, scenario_entry
 from .spec import canonical, load_campaign
 from .table import results_table
@@ -144,41 +144,22 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
     scenario = _scenario(unit["scenario"], unit["settings"])
     runs, bs = unit["runs"], unit["batch_size"]
     cells = unit["cells"]
-    estimators, accs, errors = {}, {}, {}
-    elapsed, cpu = dict.fromkeys((c["cell_id"] for c in cells), 0.0), dict.fromkeys((c["cell_id"] for c in cells), 0.0)
+    estimators = {}
+    sink = _UnitSink(unit["windows"], runs, scenario.xhat0, unit["tol"])
     for c in cells:
         t0, c0 = time.perf_counter(), time.process_time()
         try:
             estimators[c["cell_id"]] = _estimator(scenario, unit["scenario"], unit["settings"], c["estimator"],
                                                   c["options"])
-            accs[c["cell_id"]] = StatisticsAccumulator(unit["windows"], runs, unit["tol"])
         except Exception as exc:
-            errors[c["cell_id"]] = f"{type(exc).__name__}: {exc}"
-        elapsed[c["cell_id"]] += time.perf_counter() - t0
-        cpu[c["cell_id"]] += time.process_time() - c0
-    truth_s = truth_cpu = 0.0
-    batches = cell_truth_batches(scenario, unit["conditions"], unit["noise"], seed=unit["seed"], runs=runs,
-                                 batch_size=bs)
-    while True:  # the engine's open loop, with each cell's failures and time kept apart
-        t0, c0 = time.perf_counter(), time.process_time()
-        batch = next(batches, None)
-        truth_s += time.perf_counter() - t0
-        truth_cpu += time.process_time() - c0
-        if batch is None:
-            break
-        start, truth = batch
-        for c in cells:
-            cid = c["cell_id"]
-            if cid in errors:
-                continue
-            t0, c0 = time.perf_counter(), time.process_time()
-            try:
-                _run_cell_batch(estimators[cid], truth, scenario.xhat0, accs[cid], start)
-            except Exception as exc:
-                errors[cid] = f"{type(exc).__name__}: {exc}"
-            elapsed[cid] += time.perf_counter() - t0
-            cpu[cid] += time.process_time() - c0
-        del truth, batch
+            sink.fail(c["cell_id"], exc)
+        sink.timed(c["cell_id"], time.perf_counter() - t0, time.process_time() - c0)
+    if estimators:  # the engine's open loop; each cell's failures and time kept apart by the sink
+        run_monte_carlo(scenario, estimators, sink=sink, runs=runs, seed=unit["seed"], batch_size=bs,
+                        noise=unit["noise"], keep_covariance=True, diagnostics=NIS_KEYS, max_bytes=CONSISTENCY_BYTES,
+                        **unit["conditions"])
+    errors, elapsed, cpu, accs = sink.errors, sink.elapsed, sink.cpu, sink.accumulators
+    truth_s, truth_cpu = sink.truth_s, sink.truth_cpu
     out = []
     for c in cells:
         cid = c["cell_id"]
@@ -198,37 +179,32 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
 
 
 def cell_truth(scenario, conditions, noise, *, seed, runs, first_run=0):
-    """Runs ``first_run … first_run + runs − 1`` of a cell's truth (:class:`~hinfnav.sim.truth.Truth`).
-
-    The scenario's own ``campaign_truth(conditions, noise, rngs)`` when it has one (an impulse, another noise per
-    channel…; ``rngs`` the runs' child generators of ``seed``, as the simulators draw them); else the engine's
-    :func:`~hinfnav.sim.engine.truth_batch` (the scenario's ``truth_model(**conditions)``, linear or stepping
-    itself). The same seed gives the same runs whatever the batches.
-    """
-    own = getattr(scenario, "campaign_truth", None)
-    if own is not None:
-        return own(conditions, noise, child_rngs(seed, first_run + runs)[first_run:])
+    """Runs ``first_run … first_run + runs − 1`` of a cell's truth (:class:`~hinfnav.sim.truth.Truth`): the engine's
+    :func:`~hinfnav.sim.engine.truth_batch` (the scenario's own ``campaign_truth`` or ``simulate_truth`` when it has
+    one, else its ``truth_model(**conditions)``, linear or stepping itself). The same seed gives the same runs whatever
+    the batches."""
     return truth_batch(scenario, conditions, noise=noise, runs=runs, seed=seed, first_run=first_run)
 
 
-def cell_truth_batches(scenario, conditions, noise, *, seed, runs, batch_size):
-    """``(start, truth)`` of each batch of a cell's runs (:func:`cell_truth`; the engine's batches when the
-    scenario has no ``campaign_truth``)."""
-    if getattr(scenario, "campaign_truth", None) is None:
-        yield from truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed, noise=noise)
-        return
-    for start in range(0, runs, batch_size):
-        yield start, cell_truth(scenario, conditions, noise, seed=seed, runs=min(batch_size, runs - start),
-                                first_run=start)
+class _UnitSink(StatisticsSink):
+    """The engine's statistics sink of one task: also each cell's error (the cell then stops, the others go on)
+    and its wall and CPU seconds, and the seconds spent on the truth."""
 
+    def __init__(self, windows, runs, xhat0, tol):
+        super().__init__(windows, runs, xhat0, tol)
+        self.errors, self.elapsed, self.cpu = {}, defaultdict(float), defaultdict(float)
+        self.truth_s = self.truth_cpu = 0.0
 
-def _run_cell_batch(est, truth, xhat0, acc, start):
-    """Run one estimator on one truth batch into the cell's accumulator (the engine's
-    :func:`~hinfnav.sim.engine.estimate_on_truth`, in chunks of runs whose histories fit :data:`CONSISTENCY_BYTES`)."""
-    for off, hist in estimate_on_truth(est, truth, xhat0, keep_covariance=True, diagnostics=NIS_KEYS,
-                                       max_bytes=CONSISTENCY_BYTES):
-        add_batch(acc, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist, xhat0)
-        del hist
+    def fail(self, name, exc):
+        self.errors[name] = f"{type(exc).__name__}: {exc}"
+
+    def timed(self, name, wall_s, cpu_s):
+        if name is None:
+            self.truth_s += wall_s
+            self.truth_cpu += cpu_s
+        else:
+            self.elapsed[name] += wall_s
+            self.cpu[name] += cpu_s
 
 
 class CellResults(tuple):

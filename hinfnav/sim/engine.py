@@ -25,7 +25,10 @@ is simulated by :func:`~hinfnav.sim.truth.simulate_truth` (linear systems in
 closed form per step, nonlinear ones by their ``step``).
 
 A *sink* receives every batch: ``add(name, start, truth, history)`` and
-``result()``. :class:`HistorySink` keeps the histories
+``result()``; ``fail(name, exc)`` when an estimator raises (re-raised unless
+the sink records it, as a campaign cell does: that estimator then stops) and
+``timed(name, wall_s, cpu_s)`` the time of each batch (``name=None``: the
+truth). :class:`HistorySink` keeps the histories
 (:class:`~hinfnav.sim.montecarlo.SimulationResult` per estimator);
 :class:`hinfnav.metrics.StatisticsSink` keeps streaming statistics only (memory
 of one batch, whatever the runs).
@@ -33,6 +36,7 @@ of one batch, whatever the runs).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
@@ -56,7 +60,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Sink", "HistorySink", "run_monte_carlo", "truth_batch", "truth_batches", "estimate_on_truth",
            "closed_loop_batch", "truth_runs", "resolve_estimator", "resolve_estimators", "check_measurement_match", "plain_seed",
-           "results_from_parts"]
+           "results_from_parts", "batch_result"]
 
 
 class Sink:
@@ -71,6 +75,15 @@ class Sink:
         """What the Monte Carlo returns."""
         raise NotImplementedError
 
+    def fail(self, name: str, exc: Exception) -> None:
+        """Estimator ``name`` raised ``exc`` on a batch (or this sink did, adding it): re-raised by default; a sink
+        that records it and returns (a campaign's cell) gets no more batches of ``name``."""
+        raise exc
+
+    def timed(self, name: str | None, wall_s: float, cpu_s: float) -> None:
+        """Wall and CPU seconds the engine spent on one batch of estimator ``name`` (its :meth:`add` included) or,
+        with ``name=None``, on simulating one truth batch (ignored by default)."""
+
 
 def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int | np.random.SeedSequence:
     """The seed as the engine keeps it: a Generator is drawn from once, so that every batch agrees."""
@@ -81,7 +94,8 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
 
 
 def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: Any) -> Estimator:
-    """An :class:`Estimator`: given, registered under a name for ``scenario``, or built from a design.
+    """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a
+    name for ``scenario``, or built from a design.
 
     A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
     the scenario's ``estimator_from_design`` (which checks that it was
@@ -91,7 +105,7 @@ def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: An
         return build_estimator(estimator, scenario)
     if estimator is None:
         raise InputError("estimator must be given (an Estimator or a registered filter name such as 'published')")
-    if isinstance(estimator, Estimator):
+    if _estimator_like(estimator):
         return estimator
     # Anything else must be a design the scenario can run; the scenario checks its type (not imported
     # here, so that the simulation layer loads neither the design layer nor python-control).
@@ -102,6 +116,11 @@ def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: An
             raise InputError(f"estimator: {err}") from err
     raise InputError(f"estimator must be a hinfnav Estimator or a filter name (this scenario, {type(scenario).__name__}, "
                      f"cannot run a synthesized design directly); got {type(estimator).__name__}")
+
+
+def _estimator_like(obj: Any) -> bool:
+    """An Estimator, or an object with what the open loop calls (``estimate`` and ``measurement``, such as a wrapper)."""
+    return isinstance(obj, Estimator) or (callable(getattr(obj, "estimate", None)) and hasattr(obj, "measurement"))
 
 
 def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
@@ -117,7 +136,7 @@ def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
     out = {}
     for key, e in items:
         est = resolve_estimator(e, scenario)
-        name = est.name if key is None else key
+        name = getattr(est, "name", type(est).__name__) if key is None else key
         if name in out:
             raise InputError(f"estimators: the name {name!r} is given twice; pass a mapping name -> estimator")
         out[name] = est
@@ -149,9 +168,19 @@ def truth_batch(scenario: Any, conditions: Mapping[str, Any], *, noise: str | No
     """The truth of runs ``first_run … first_run + runs − 1`` of ``scenario`` under ``conditions``.
 
     The scenario's own ``simulate_truth`` when it has one (see the module
-    docstring), else :func:`~hinfnav.sim.truth.simulate_truth` of ``model``
-    (default ``scenario.truth_model(**conditions)``).
+    docstring), or its ``campaign_truth(conditions, noise, rngs)`` (``rngs`` the
+    runs' child generators of ``seed``, as the simulators draw them: an
+    impulse, another noise per channel…), else
+    :func:`~hinfnav.sim.truth.simulate_truth` of ``model`` (default
+    ``scenario.truth_model(**conditions)``).
     """
+    campaign = getattr(scenario, "campaign_truth", None)
+    if callable(campaign):
+        truth = campaign(dict(conditions), noise, child_rngs(seed, runs, first_run))
+        if not isinstance(truth, Truth):
+            raise InputError(f"{type(scenario).__name__}.campaign_truth must return a hinfnav Truth; "
+                             f"got {type(truth).__name__}")
+        return truth
     own = getattr(scenario, "simulate_truth", None)
     if callable(own):
         truth = own(noise=noise, measurement_noise=measurement_noise, runs=runs, seed=seed, first_run=first_run,
@@ -172,7 +201,8 @@ def truth_batches(scenario: Any, conditions: Mapping[str, Any], *, runs: int, ba
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
     seed = plain_seed(seed)
-    model = None if callable(getattr(scenario, "simulate_truth", None)) else scenario_truth_model(scenario, dict(conditions))
+    own = callable(getattr(scenario, "simulate_truth", None)) or callable(getattr(scenario, "campaign_truth", None))
+    model = None if own else scenario_truth_model(scenario, dict(conditions))
     for start in range(0, runs, batch_size):
         yield start, truth_batch(scenario, conditions, noise=noise, measurement_noise=measurement_noise,
                                  runs=min(batch_size, runs - start), seed=seed, first_run=start, model=model)
@@ -310,27 +340,55 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
         w_model, v_model = noise_models(noise, measurement_noise, model.system.dt)
     desc = ", ".join(ests) + (" (closed loop)" if loop else "")
     with tqdm(total=runs, disable=bar_disabled(progress), desc=desc, unit="run") as bar:
+        failed = set()  # estimators whose failure the sink recorded: run no more
         if not loop:
-            for start, truth in truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed,
-                                              noise=noise, measurement_noise=measurement_noise):
+            batches = truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed, noise=noise,
+                                    measurement_noise=measurement_noise)
+            while True:
+                t0, c0 = time.perf_counter(), time.process_time()
+                batch = next(batches, None)
+                sink.timed(None, time.perf_counter() - t0, time.process_time() - c0)
+                if batch is None:
+                    break
+                start, truth = batch
                 for name, est in ests.items():
-                    for off, hist in estimate_on_truth(est, truth, xhat0, P0=P0, keep_covariance=keep_covariance,
-                                                       diagnostics=diagnostics, max_bytes=max_bytes):
-                        sink.add(name, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist)
+                    if name in failed:
+                        continue
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    try:
+                        for off, hist in estimate_on_truth(est, truth, xhat0, P0=P0, keep_covariance=keep_covariance,
+                                                           diagnostics=diagnostics, max_bytes=max_bytes):
+                            sink.add(name, start + off, truth_runs(truth, off, hist.xhat.shape[0]), hist)
+                            del hist
+                    except Exception as exc:
+                        failed.add(name)
+                        sink.fail(name, exc)
+                    sink.timed(name, time.perf_counter() - t0, time.process_time() - c0)
                 bar.update(truth.x.shape[0])
+                del truth, batch  # before the next batch is simulated: the memory of one batch
             return sink.result()
         n1 = model.n_steps + 1
         for start in range(0, runs, batch_size):
             n = min(batch_size, runs - start)
-            w, v = draw_noise(w_model, v_model, child_rngs(seed, start + n)[start:], n1, model.system.n_noise,
+            w, v = draw_noise(w_model, v_model, child_rngs(seed, n, start), n1, model.system.n_noise,
                               model.measurement.n_noise)
             for name, est in ests.items():
-                truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0, keep_covariance=keep_covariance,
-                                                diagnostics=diagnostics)
-                settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
-                                seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
-                                feedback=getattr(law, "source", "estimate"))
-                sink.add(name, start, replace(truth, settings=settings), hist)
+                if name in failed:
+                    continue
+                t0, c0 = time.perf_counter(), time.process_time()
+                try:
+                    truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0,
+                                                    keep_covariance=keep_covariance, diagnostics=diagnostics)
+                    settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
+                                    seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
+                                    feedback=getattr(law, "source", "estimate"))
+                    sink.add(name, start, replace(truth, settings=settings), hist)
+                    del truth, hist
+                except Exception as exc:
+                    failed.add(name)
+                    sink.fail(name, exc)
+                sink.timed(name, time.perf_counter() - t0, time.process_time() - c0)
+            del w, v  # before the next batch is drawn: the memory of one batch
             bar.update(n)
     return sink.result()
 
@@ -373,6 +431,13 @@ def results_from_parts(parts: Sequence[SimulationResult], runs: int) -> Simulati
                             diagnostics=diag, xhat0=first.xhat0)
 
 
+def batch_result(name: str, truth: Truth, history: EstimateHistory, xhat0: ArrayLike) -> SimulationResult:
+    """The :class:`SimulationResult` of one batch that a sink receives (``settings["filter"]`` = ``name``)."""
+    return SimulationResult(t=truth.t, x=truth.x, xhat=history.xhat, u=truth.u, y=truth.y, P=history.P,
+                            settings=dict(truth.settings, filter=name), state=truth.state,
+                            diagnostics=history.diagnostics, xhat0=np.asarray(xhat0, dtype=float))
+
+
 class HistorySink(Sink):
     """Keeps every history: ``result()`` is name → :class:`SimulationResult` of all runs.
 
@@ -390,10 +455,7 @@ class HistorySink(Sink):
         self.parts: dict[str, list[SimulationResult]] = {}
 
     def add(self, name: str, start: int, truth: Truth, history: EstimateHistory) -> None:
-        settings = dict(truth.settings, filter=name)
-        self.parts.setdefault(name, []).append(SimulationResult(
-            t=truth.t, x=truth.x, xhat=history.xhat, u=truth.u, y=truth.y, P=history.P, settings=settings,
-            state=truth.state, diagnostics=history.diagnostics, xhat0=self.xhat0))
+        self.parts.setdefault(name, []).append(batch_result(name, truth, history, self.xhat0))
 
     def result(self) -> dict[str, SimulationResult]:
         return {name: results_from_parts(parts, self.runs) for name, parts in self.parts.items()}

@@ -132,13 +132,29 @@ def scenario_truth_model(scenario: Any, conditions: dict[str, Any]) -> TruthMode
     return build(**conditions)
 
 
-def child_rngs(seed: int | np.random.SeedSequence | np.random.Generator, runs: int) -> list[np.random.Generator]:
-    """``runs`` independent generators from ``seed`` (an int ≥ 0, a SeedSequence or a Generator)."""
+def child_rngs(seed: int | np.random.SeedSequence | np.random.Generator, runs: int, first: int = 0) -> list[np.random.Generator]:
+    """The independent generators of runs ``first … first + runs − 1`` from ``seed`` (an int ≥ 0, a SeedSequence
+    or a Generator).
+
+    Run r's generator is the r-th child of ``numpy.random.default_rng(seed)``
+    (``Generator.spawn``); from an int or a SeedSequence it is built directly
+    (``SeedSequence(entropy, spawn_key=(…, r))``, what ``spawn`` builds), so that a
+    batch of late runs neither builds the generators of the runs before it
+    (time and memory that would grow with the runs) nor depends on what was
+    spawned from the SeedSequence before. A Generator is spawned from (its children
+    ``first …`` of this call).
+    """
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer, np.random.SeedSequence, np.random.Generator)):
         raise InputError(f"seed must be a non-negative integer or a numpy.random.Generator; got {seed!r}")
     if isinstance(seed, (int, np.integer)) and seed < 0:
         raise InputError(f"seed must be a non-negative integer; got {seed}")
-    return np.random.default_rng(seed).spawn(runs)
+    first = as_int_at_least("first", first, 0)
+    if isinstance(seed, np.random.Generator):
+        return seed.spawn(first + runs)[first:]
+    parent = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(int(seed))
+    return [np.random.Generator(np.random.PCG64(np.random.SeedSequence(
+        parent.entropy, spawn_key=tuple(parent.spawn_key) + (r,), pool_size=parent.pool_size)))
+        for r in range(first, first + runs)]
 
 
 def _noise_at(noise, dt, name):
@@ -211,7 +227,7 @@ def simulate_truth(model: TruthModel, *, noise: str | NoiseModel = "gaussian", m
         raise InputError(f"model.system must be a LinearSystem or offer step(x, u, w, t); got {type(system).__name__}")
     w_model, v_model = noise_models(noise, measurement_noise, system.dt)
     n1 = model.n_steps + 1
-    rngs = child_rngs(seed, first_run + runs)[first_run:]
+    rngs = child_rngs(seed, runs, first_run)
     w, v = draw_noise(w_model, v_model, rngs, n1, system.n_noise, meas.n_noise)
     x = np.empty((runs, n1, system.n))
     x[:, 0] = model.x0

@@ -284,7 +284,7 @@ class Scenario(BaseScenario):
         runs = as_int_at_least("runs", runs, 1)
         first_run = as_int_at_least("first_run", first_run, 0)
         w_model, v_model = noise_models(noise, measurement_noise, self.dt)
-        rngs = child_rngs(seed, first_run + runs)[first_run:]
+        rngs = child_rngs(seed, runs, first_run)
         _, v = draw_noise(w_model, v_model, rngs, model.n_steps + 1, model.system.n_noise, model.measurement.n_noise)
         x = truth.x + self.maneuver_response()
         settings = dict(truth.settings, maneuver=True, maneuver_time_s=self.maneuver_time_s,

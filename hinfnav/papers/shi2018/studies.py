@@ -21,15 +21,12 @@ given as the mean of the paired per-run differences with its 95 % interval.
 from dataclasses import dataclass, field
 
 import numpy as np
-from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...io.progress import bar_disabled
 from ...core.validation import as_choice, as_int_at_least
-from ...estimators.huber_filter import HuberFilter
 from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
-from ...sim.montecarlo import check_measurement_match
+from ...sim.engine import Sink, run_monte_carlo
 from .constants import MIXTURE_EPS, MIXTURE_RATIO
 from .filters import EKF, HBF
 from .scenario import ContaminatedNoise, Scenario
@@ -140,9 +137,41 @@ def _rms_axes(err, mask):
     return np.sqrt(np.mean(err[:, mask] ** 2, axis=1))
 
 
+class _CaseSink(Sink):
+    """The statistics :func:`run_case` keeps of each batch (the engine's sink; memory of one batch)."""
+
+    def __init__(self, names, n1, mask, win_masks):
+        self.mask, self.win_masks = mask, win_masks
+        self.acc = {name: {"per_run": [], "windows": {k: [] for k in win_masks}, "jitter": [], "max_abs": [],
+                           "sum": np.zeros((n1, 6)), "sumsq": np.zeros((n1, 6)), "single": None, "down": [0, 0]}
+                    for name in names}
+
+    def add(self, name, start, truth, history):
+        err = truth.state.error(truth.x, history.xhat)
+        a, mask = self.acc[name], self.mask
+        a["per_run"].append(_rms_axes(err, mask))
+        for k, m in self.win_masks.items():
+            a["windows"][k].append(_rms_axes(err, m))
+        d = np.diff(err[:, mask], axis=1)
+        a["jitter"].append(np.sqrt(np.mean(d**2, axis=1)))
+        a["max_abs"].append(np.max(np.abs(err[:, mask]), axis=1))
+        a["sum"] += err.sum(axis=0)
+        a["sumsq"] += (err**2).sum(axis=0)
+        if start == 0:
+            a["single"] = err[0].copy()
+        if "weights" in history.diagnostics:
+            w = history.diagnostics["weights"][:, mask, :truth.measurement.n_meas]
+            a["down"][0] += int(np.count_nonzero(w < 1.0))
+            a["down"][1] += w.size
+
+    def result(self):
+        return self.acc
+
+
 def run_case(scenario, case, filters=None, *, runs=100, seed=0, batch_size=100, progress=False,
              mixture_eps=MIXTURE_EPS, mixture_ratio=MIXTURE_RATIO):
-    """Run filters on one case's truths, batch by batch (memory of one batch).
+    """Run filters on one case's truths through the Monte Carlo engine (:func:`hinfnav.sim.run_monte_carlo`),
+    batch by batch (memory of one batch).
 
     Parameters
     ----------
@@ -176,35 +205,10 @@ def run_case(scenario, case, filters=None, *, runs=100, seed=0, batch_size=100, 
     win_masks = {}
     if case == "maneuver":
         win_masks = {k: window_mask(t, w) for k, w in maneuver_windows(scenario).items() if w[0] < w[1]}
-    acc = {name: {"per_run": [], "windows": {k: [] for k in win_masks}, "jitter": [], "max_abs": [],
-                  "sum": np.zeros((t.size, 6)), "sumsq": np.zeros((t.size, 6)), "single": None, "down": [0, 0]}
-           for name in filters}
-    with tqdm(total=runs * len(filters), disable=bar_disabled(progress), desc=f"{case}", unit="run") as bar:
-        for start in range(0, runs, batch_size):
-            n = min(batch_size, runs - start)
-            truth = scenario.simulate_truth(noise="gaussian", runs=n, seed=seed, first_run=start, **conditions)
-            for name, est in filters.items():
-                check_measurement_match(est, truth.measurement)
-                hist = est.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False,
-                                    diagnostics="weights" in _diagnostic_keys(est))
-                err = truth.state.error(truth.x, hist.xhat)
-                a = acc[name]
-                a["per_run"].append(_rms_axes(err, mask))
-                for k, m in win_masks.items():
-                    a["windows"][k].append(_rms_axes(err, m))
-                d = np.diff(err[:, mask], axis=1)
-                a["jitter"].append(np.sqrt(np.mean(d**2, axis=1)))
-                a["max_abs"].append(np.max(np.abs(err[:, mask]), axis=1))
-                a["sum"] += err.sum(axis=0)
-                a["sumsq"] += (err**2).sum(axis=0)
-                if start == 0:
-                    a["single"] = err[0].copy()
-                if "weights" in hist.diagnostics:
-                    m_rows = est.measurement.n_meas
-                    w = hist.diagnostics["weights"][:, mask, :m_rows]
-                    a["down"][0] += int(np.count_nonzero(w < 1.0))
-                    a["down"][1] += w.size
-                bar.update(n)
+    sink = _CaseSink(filters, t.size, mask, win_masks)
+    acc = run_monte_carlo(scenario, filters, sink=sink, runs=runs, seed=seed, batch_size=batch_size, noise="gaussian",
+                          measurement_noise=conditions["measurement_noise"], keep_covariance=False,
+                          diagnostics=("weights",), progress=progress, maneuver=conditions["maneuver"])
     stats = {}
     for name, a in acc.items():
         stats[name] = FilterStats(
@@ -224,11 +228,6 @@ def run_case(scenario, case, filters=None, *, runs=100, seed=0, batch_size=100, 
                 "process_noise": "gaussian", "runs": runs, "seed": seed}
     return CaseResult(case=case, t=t, runs=runs, seed=seed, window_s=scenario.rms_window_s, filters=stats,
                       settings=settings)
-
-
-def _diagnostic_keys(est):
-    """The HBF reports weights; asking the others for diagnostics would only cost memory."""
-    return ("weights",) if isinstance(est, HuberFilter) else ()
 
 
 def accuracy(per_axis):

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...metrics.errors import rms_error
+from ...metrics.errors import convergence_time, rms_error
 from ...plotting.errors import new_figure
 from ...sim.closed_loop import simulate_closed_loop
 from .designs import design_for_scenario
@@ -58,18 +58,6 @@ class ClosedLoopStudy:
     rows: list
     results: dict
     settings: dict = field(default_factory=dict)
-
-
-def _arrival_time(rng_hist, t, limit):
-    inside = rng_hist <= limit
-    out = np.full(rng_hist.shape[0], np.nan)
-    for r in range(rng_hist.shape[0]):
-        bad = np.flatnonzero(~inside[r])
-        if bad.size == 0:
-            out[r] = t[0]
-        elif bad[-1] < t.size - 1:
-            out[r] = t[bad[-1] + 1]
-    return out
 
 
 def closed_loop_study(scenario=None, *, runs=20, seed=0, noise="gaussian", designed=None, arrive_m=5.0, progress=False):
@@ -110,7 +98,7 @@ def closed_loop_study(scenario=None, *, runs=20, seed=0, noise="gaussian", desig
         results[key] = res
         r = np.linalg.norm(res.state.select(res.x, "position"), axis=-1)
         thrust = np.linalg.norm(res.u, axis=-1)
-        arrival = _arrival_time(r, res.t, arrive_m)
+        arrival = convergence_time(r[..., None], res.t, arrive_m, nonfinite="outside")  # first t after which |r| <= arrive_m
         comp = rms_error(res.error, res.t, scenario.rms_window_s)
         rows.append({
             "key": key,

@@ -31,8 +31,7 @@ from ...io.progress import bar_disabled
 from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
 from ...metrics.intervals import format_interval, mean_interval
-from ...sim.montecarlo import run_estimator
-from ...sim.truth import simulate_truth
+from ...sim.engine import Sink, batch_result, run_monte_carlo
 from .constants import PAPER_TABLE1, published_filter
 from .designs import design_for_scenario
 from .filters import lti_from_matrices, make_estimator
@@ -178,6 +177,26 @@ def row_command(key, maneuver, runs, seed, delta_bar=0.05):
     return f"python -m hinfnav simulate --filter {name}{tail}"
 
 
+class _CellSink(Sink):
+    """What :func:`table1` keeps of each batch of the Monte Carlo engine: the per-run :func:`cell_values` of each
+    filter over ``window`` (and of the EKF over each of ``ekf_windows``); ``bar`` counts filter batches."""
+
+    def __init__(self, keys, xhat0, window, ekf_windows, bar):
+        self.xhat0, self.window, self.ekf_windows, self.bar = xhat0, window, tuple(ekf_windows), bar
+        self.values = {(key, w): [] for key in keys for w in ["main"] + [label for label, _ in EKF_WINDOWS]}
+
+    def add(self, name, start, truth, history):
+        res = batch_result(name, truth, history, self.xhat0)
+        self.values[name, "main"].append(cell_values(res, truth.t, self.window))
+        if name == "ekf":
+            for label, w in self.ekf_windows:
+                self.values[name, label].append(cell_values(res, truth.t, w))
+        self.bar.update(1)
+
+    def result(self):
+        return self.values
+
+
 def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, progress=False, batch_size=100,
            delta_bar=None):
     """Compute the reproduced Table 1.
@@ -229,20 +248,10 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     total = len(CASES) * len(keys) * -(-runs // batch_size)
     with tqdm(total=total, disable=bar_disabled(progress), desc="Table 1", unit="filter") as bar:
         for case, maneuver in CASES.items():
-            model = scenario.truth_model(maneuver=maneuver)
             ests = _estimators(scenario, designed, maneuver, observer)
-            values = {(key, w): [] for key in keys for w in ["main"] + [label for label, _ in EKF_WINDOWS]}
-            for start in range(0, runs, batch_size):
-                truth = simulate_truth(model, runs=min(batch_size, runs - start), seed=seed, first_run=start)
-                for key, est in ests.items():
-                    res = run_estimator(est, truth, scenario.xhat0)
-                    values[key, "main"].append(cell_values(res, truth.t, win))
-                    if case == "maneuver" and key == "ekf":
-                        for label, w in EKF_WINDOWS:
-                            values[key, label].append(cell_values(res, truth.t, w))
-                    del res
-                    bar.update(1)
-                del truth
+            sink = _CellSink(keys, scenario.xhat0, win, EKF_WINDOWS if case == "maneuver" else (), bar)
+            values = run_monte_carlo(scenario, ests, sink=sink, runs=runs, seed=seed, batch_size=batch_size,
+                                     keep_covariance=False, maneuver=maneuver)
             cells[case] = {}
             for (key, w), parts in values.items():
                 if not parts:

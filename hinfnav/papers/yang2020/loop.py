@@ -208,6 +208,9 @@ def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True
 #: Scenario fields that only the controller (``integral``) or the post-processing (``residual``) reads: loops that
 #: differ only in these (and in the controller) share the plant, the noise and the estimator and are batched.
 CONTROLLER_FIELDS = ("integral", "residual")
+#: Scenario fields that change the noise levels, the disturbance or the estimator (not the plant's matrices nor the
+#: loop's timing): loops that differ in these are batched too, each group of equal readings with its own estimator.
+FILTER_FIELDS = ("noise", "omega_d", "fused_covariance")
 
 
 def _check_variants(variants):
@@ -223,12 +226,12 @@ def _check_variants(variants):
             raise InputError(f"variants[{i}] must be a (scenario, controller) pair; got {pair!r}")
         sc = check_scenario(pair[0])
         out.append((sc, as_choice("controller", pair[1], CONTROLLERS)))
-    blank = {key: "off" if key == "integral" else "test_mass" for key in CONTROLLER_FIELDS}
-    common = replace(out[0][0], **blank)
+    first = out[0][0]
+    blank = {key: getattr(first, key) for key in CONTROLLER_FIELDS + FILTER_FIELDS}
     for i, (sc, _) in enumerate(out[1:], 1):
-        if replace(sc, **blank) != common:
-            raise InputError(f"variants[{i}]'s scenario differs from variants[0]'s beyond {CONTROLLER_FIELDS}: "
-                             "only loops on the same plant, noise and estimator are batched")
+        if replace(sc, **blank) != first:
+            raise InputError(f"variants[{i}]'s scenario differs from variants[0]'s beyond "
+                             f"{CONTROLLER_FIELDS + FILTER_FIELDS}: only loops on the same plant and timing are batched")
     return out
 
 
@@ -258,31 +261,52 @@ def run_closed_loops(variants, *, runs=1, seed=0, passive=True, passive_steps=10
     list of LoopResult
         One per variant, in order.
     """
-    pairs = _check_variants(variants)
-    nv = len(pairs)
+    given = _check_variants(variants)
+    nv = len(given)
     runs = as_int_at_least("runs", runs, 1)
     flags = [bool(passive)] * nv if np.ndim(passive) == 0 else [bool(p) for p in passive]
     if len(flags) != nv:
         raise InputError(f"passive must be one bool or {nv} (one per variant); got {len(flags)}")
     if isinstance(seed, np.random.Generator):
         seed = int(seed.integers(2**63))
+    # rows grouped by estimator (FILTER_FIELDS): each group a contiguous slice with its own Algorithm 3
+    keys = [tuple(getattr(sc, f) for f in FILTER_FIELDS) for sc, _ in given]
+    group_keys = list(dict.fromkeys(keys))
+    order = sorted(range(nv), key=lambda v: group_keys.index(keys[v]))
+    pairs, flags = [given[v] for v in order], [flags[v] for v in order]
+    if any(fl and keys[v] != keys[order[0]] for v, fl in zip(order, flags)):
+        raise InputError("the standalone estimators (passive) run on the variants of the first variant's readings only")
     rngs = child_rngs(seed, runs)
     sc = pairs[0][0]
     m = sc.model
     n1 = sc.n_steps + 1
     rows = nv * runs
     t = np.arange(n1) * sc.dt
-    f = disturbance(t, sc.w_d)
     ref = sc.attitude_reference(n1)
     law = DragFreeADRC.stacked([s.controller(kind) for s, kind in pairs], runs)  # one call for every row
     slices = [slice(v * runs, (v + 1) * runs) for v in range(nv)]
-    fused = build_fused(sc, steady_tol=sc.steady_tol)
+    groups = []  # (rows slice, fused filter, its state, first variant)
+    for key in group_keys:
+        vs = [v for v in range(nv) if keys[order[v]] == key]
+        g_sc = pairs[vs[0]][0]
+        fused = build_fused(g_sc, steady_tol=g_sc.steady_tol)
+        groups.append([slice(vs[0] * runs, (vs[-1] + 1) * runs), fused, fused.start(g_sc.xhat0, None, len(vs) * runs),
+                       None])
+    one = len(groups) == 1
     lo, up = ACCELEROMETER_RANGE
-    sd_w, sd_d, sd_a = sc.input_std, sc.sensor_std, sc.accel_std
+    if one:  # per-step standard deviations of w, d, d_a
+        sd_w, sd_d, sd_a = sc.input_std, sc.sensor_std, sc.accel_std
+    else:
+        sd_w, sd_d, sd_a = (np.repeat(np.stack([getattr(s, name) for s, _ in pairs]), runs, axis=0)[:, None]
+                            for name in ("input_std", "sensor_std", "accel_std"))
+    fs_v = [disturbance(t, s.w_d) for s, _ in pairs]
+    same_f = all(s.w_d == sc.w_d for s, _ in pairs)
+    F = fs_v[0] if same_f else np.repeat(np.stack(fs_v), runs, axis=0)  # (n1, 9) or (rows, n1, 9)
     PhiT, GamT, CaT = m.Phi.T, m.Gamma.T, m.accel_C.T
 
     x_h = np.empty((rows, n1, 18))
     u_h, g_h, xhat_h, acc_h = (np.empty((rows, n1, k)) for k in (9, 9, 27, 3))
+    xhat = np.empty((rows, 27))
     clipped = np.zeros(nv, dtype=int)
     n_passive = min(n1, as_int_at_least("passive_steps", passive_steps, 0)) if any(flags) else 0
     prow = np.concatenate([np.arange(rows)[sl] for sl, fl in zip(slices, flags) if fl]) if n_passive else None
@@ -293,41 +317,48 @@ def run_closed_loops(variants, *, runs=1, seed=0, passive=True, passive_steps=10
         bank = Alg2Bank(build_alg2(sc, mode="truncated"), prow.size)
         all_passive = prow.size == rows
     x = np.broadcast_to(sc.x0, (rows, 18)).copy()
-    fs = fused.start(sc.xhat0, None, rows)
     cs = law.start(rows)
     prior = sc.timing == "prior"
     u_prev = np.zeros((rows, 9))  # input and input noise of the hold interval that ends at t_k
     w_prev = np.zeros((rows, 9))
-    steady_at = None
     for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({', '.join(p[1] for p in pairs)})",
                   unit="step", mininterval=1.0, leave=False):
         j = k % BLOCK
         if j == 0:
             nb = min(BLOCK, n1 - k)
             blocks = [[rng.standard_normal((nb, p)) for p in (9, 9, 3)] for rng in rngs]
-            W, Dn, Da = (np.tile(np.stack([b[i] for b in blocks]) * sd, (nv, 1, 1))
+            W, Dn, Da = (np.tile(np.stack([b[i] for b in blocks]), (nv, 1, 1)) * sd
                          for i, sd in enumerate((sd_w, sd_d, sd_a)))
-        fk, wk = f[k], W[:, j]
+        fk, wk = (F[k] if same_f else F[:, k]), W[:, j]
         if prior:
-            u, ucmd, cs = law(fs.x, ref[k], cs)
+            x_prior = groups[0][2].x if one else np.concatenate([grp[2].x for grp in groups])
+            u, ucmd, cs = law(x_prior, ref[k], cs)
             u_read, w_read = u, wk
         else:
             u_read, w_read = u_prev, w_prev
         Y = x[:, MEASURED_INDICES] + Dn[:, j]
-        a_raw = x @ CaT + (u_read[:, 3:6] + w_read[:, 3:6] + fk[3:6]) * (1.0 / M_SC) + Da[:, j]
+        a_raw = x @ CaT + (u_read[:, 3:6] + w_read[:, 3:6] + fk[..., 3:6]) * (1.0 / M_SC) + Da[:, j]
         a_c = np.clip(a_raw, lo, up)
-        fs = fused.feed_input(fs, u_read)
-        fs, out = fused.update(fs, np.concatenate([Y, a_c], axis=1))
+        Yall = np.concatenate([Y, a_c], axis=1)
+        for grp in groups:
+            sl, fused, fs = grp[0], grp[1], grp[2]
+            fs = fused.feed_input(fs, u_read if one else u_read[sl])
+            fs, out = fused.update(fs, Yall if one else Yall[sl])
+            grp[2] = fs
+            if one:
+                xhat = out.xhat
+            else:
+                xhat[sl] = out.xhat
+            if grp[3] is None and fs.extra["steady"] is not None:
+                grp[3] = k
         if not prior:
-            u, ucmd, cs = law(out.xhat, ref[k], cs)
+            u, ucmd, cs = law(xhat, ref[k], cs)
         if nv == 1:
             clipped[0] += bool(np.any(u != ucmd))
         else:
             clipped += np.any((u != ucmd).reshape(nv, -1), axis=1)
         g = u + wk + fk
-        if steady_at is None and fs.extra["steady"] is not None:
-            steady_at = k
-        x_h[:, k], u_h[:, k], g_h[:, k], xhat_h[:, k], acc_h[:, k] = x, u, g, out.xhat, a_raw
+        x_h[:, k], u_h[:, k], g_h[:, k], xhat_h[:, k], acc_h[:, k] = x, u, g, xhat, a_raw
         if k < n_passive:
             Yp, up_, ur, ar, ac = ((Y, u, u_read, a_raw, a_c) if all_passive else
                                    (Y[prow], u[prow], u_read[prow], a_raw[prow], a_c[prow]))
@@ -335,22 +366,23 @@ def run_closed_loops(variants, *, runs=1, seed=0, passive=True, passive_steps=10
             pas["alg1"][:, k] = o1.xhat[:, 9:18]
             s1 = a1.predict(s1, up_)
             pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(ar, ac, ur[:, 3:6], up_[:, 3:6])
-        fs = fused.predict(fs, u)
+        for grp in groups:
+            grp[2] = grp[1].predict(grp[2], u if one else u[grp[0]])
         x = x @ PhiT + g @ GamT
         u_prev, w_prev = u, wk
-    results = []
+    results = [None] * nv
     first = 0
     for v, ((s, kind), sl) in enumerate(zip(pairs, slices)):
+        grp = next(g for g in groups if g[0].start <= sl.start < g[0].stop)
         settings = dict(s.readings, controller=kind, runs=runs, seed=seed, n_steps=s.n_steps, dt=s.dt, w_d=s.w_d,
-                        steady_tol=s.steady_tol, fused_steady_from_step=steady_at,
-                        clipped_input_steps=int(clipped[v]), theta_alg1=float(fused.alg1.theta),
-                        theta_alg2=fused.alg2.theta.tolist())
+                        steady_tol=s.steady_tol, fused_steady_from_step=grp[3],
+                        clipped_input_steps=int(clipped[v]), theta_alg1=float(grp[1].alg1.theta),
+                        theta_alg2=grp[1].alg2.theta.tolist())
         if flags[v] and n_passive:
             pv = {name: h[first:first + runs] for name, h in pas.items()}
             first += runs
         else:
             pv = {}
-        results.append(LoopResult(t=t, x=x_h[sl], f=f, u=u_h[sl], drive=g_h[sl], acc=acc_h[sl], xhat=xhat_h[sl],
-                                  passive=pv, reference=ref, settings=settings))
+        results[order[v]] = LoopResult(t=t, x=x_h[sl], f=fs_v[v], u=u_h[sl], drive=g_h[sl], acc=acc_h[sl],
+                                       xhat=xhat_h[sl], passive=pv, reference=ref, settings=settings)
     return results
-
