@@ -91,7 +91,7 @@ def counting():
                 raise KeyboardInterrupt  # what Ctrl-C does in the middle of a campaign
             return self.inner.estimate(*args, **kwargs)
 
-    register_estimator("test_counting", lambda sc, **kw: Counting(build_estimator("published", sc)),
+    register_estimator("test_counting", lambda sc, **kw: Counting(build_estimator(sc, "published")),
                        fits=lambda sc: isinstance(sc, Scenario))
     yield calls
     _REGISTRY.pop("test_counting", None)

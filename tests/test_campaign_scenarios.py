@@ -43,10 +43,10 @@ def test_the_five_families_on_the_scenarios_and_the_lmi_designs_only_where_linea
     for key in ("shi2018", "yang2020"):
         assert {"model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_adaptive"} <= fits[key]
     # the generic sigma-point filter (additive error) on the quaternion state: not fitting, with the reason
-    assert "quaternion" in fit_reason("ukf", build_scenario("attitude2018"))
+    assert "quaternion" in fit_reason(build_scenario("attitude2018"), "ukf")
     assert "designed" in fits["sun2011"] and not any("designed" in fits[k] for k in ("shi2018", "attitude2018", "yang2020"))
     with pytest.raises(InputError, match="does not fit"):
-        build_estimator("model_ekf", build_scenario("attitude2018"))
+        build_estimator(build_scenario("attitude2018"), "model_ekf")
 
 
 def test_shi_truth_draws_do_not_depend_on_the_batch_and_the_maneuver_is_the_only_difference():

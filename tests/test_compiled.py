@@ -84,14 +84,14 @@ def _assert_same(ref, got):
 
 def test_the_kernel_lists_cover_every_registered_estimator():
     assert set(NAMES) == WITH_KERNEL | WITHOUT_KERNEL
-    have = {name for name in NAMES if kernel_status(build_estimator(name, _scenario(name))) is None}
+    have = {name for name in NAMES if kernel_status(build_estimator(_scenario(name), name)) is None}
     assert have == WITH_KERNEL
 
 
 @pytest.mark.parametrize("name", sorted(WITH_KERNEL))
 def test_numba_equals_numpy(name, chaser_truth):
     y, u = chaser_truth
-    est = build_estimator(name, SUN)
+    est = build_estimator(SUN, name)
     ref = est.estimate(y, u, SUN.xhat0)
     _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"))
     assert select_backend(est, "auto") == "numba"
@@ -101,7 +101,7 @@ def test_numba_equals_numpy(name, chaser_truth):
 def test_numba_keeps_what_it_is_asked(keep, chaser_truth):
     y, u = chaser_truth
     for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
-        est = build_estimator(name, SUN)
+        est = build_estimator(SUN, name)
         ref = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep)
         got = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep, backend="numba")
         if keep is False:
@@ -113,7 +113,7 @@ def test_numba_keeps_what_it_is_asked(keep, chaser_truth):
 
 @pytest.mark.parametrize("name", sorted(WITHOUT_KERNEL))
 def test_no_kernel_refuses_numba_and_auto_runs_numpy(name):
-    est = build_estimator(name, _scenario(name))
+    est = build_estimator(_scenario(name), name)
     assert kernel_status(est)
     with pytest.raises(hn.InputError, match="backend='numba' is not available"):
         est.estimate(np.zeros((1, 2, est.measurement.n_meas)), np.zeros((1, 2, max(est.n_input, 1))),
@@ -123,7 +123,7 @@ def test_no_kernel_refuses_numba_and_auto_runs_numpy(name):
 
 def test_backend_options_checked(chaser_truth):
     y, u = chaser_truth
-    est = build_estimator("hbf", SUN)
+    est = build_estimator(SUN, "hbf")
     with pytest.raises(hn.InputError, match="backend"):
         est.estimate(y, u, SUN.xhat0, backend="fortran")
     with pytest.raises(hn.InputError, match="diagnostics"):
@@ -137,7 +137,7 @@ def test_backend_options_checked(chaser_truth):
 def test_a_failing_kernel_hands_back_to_numpy(chaser_truth):
     # theta far beyond the existence bound: the kernel's Cholesky of N fails, the NumPy path raises its error
     y, u = chaser_truth
-    ref = build_estimator("recursive_hinf", SUN)
+    ref = build_estimator(SUN, "recursive_hinf")
     est = RecursiveHInfinityFilter(ref.system, ref.measurement, theta=1e6, P0=ref.P0, Q=ref.Q, R=ref.R)
     with pytest.raises(hn.InputError, match="theta"):
         est.estimate(y, u, SUN.xhat0, backend="numba")

@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
-__all__ = ["accepts_old_order"]
+__all__ = ["accepts_old_order", "scenario_moved", "scenario_keyword"]
 
 
 def accepts_old_order(old_order: Sequence[str], is_new: Callable[[tuple, dict], bool], *,
@@ -69,3 +69,29 @@ def accepts_old_order(old_order: Sequence[str], is_new: Callable[[tuple, dict], 
 
     return decorate
 
+
+
+def scenario_moved(*old_order: str, was: type | tuple[type, ...] | Callable[[Any], bool],
+                   **fill: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Decorator of a function whose scenario moved to the front from its place in ``old_order``.
+
+    Parameters
+    ----------
+    *old_order : str
+        The positional parameters in their earlier order.
+    was : type, tuple of types or callable
+        What the earlier first argument is (e.g. ``str`` for a registry name,
+        ``callable`` for a builder): a call whose first positional argument is
+        an instance of it (or for which the predicate holds) is in the earlier
+        order. A scenario must never match it.
+    **fill
+        As in :func:`accepts_old_order`.
+    """
+    test = (lambda value: isinstance(value, was)) if isinstance(was, (type, tuple)) else was
+    return accepts_old_order(old_order, lambda args, kwargs: not args or not test(args[0]), fill=fill)
+
+
+def scenario_keyword(*old_order: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Decorator of a function whose optional scenario, at its place in ``old_order``, became keyword-only."""
+    n = old_order.index("scenario")
+    return accepts_old_order(old_order, lambda args, kwargs: len(args) <= n)
