@@ -55,6 +55,9 @@ def test_registry_build_estimator_and_fit_reason():
     assert new_order(fit_reason, SUN, "ekf") is None and new_order(fit_reason, scenario=SUN, name="ekf") is None
     with pytest.raises(TypeError, match="at most 2 positional"):
         build_estimator("ekf", SUN, "extra")
+    # a name in both places is read in the present order: a scenario wrongly given as a str is named as such
+    with pytest.raises(hinfnav.InputError, match=r"does not fit this scenario \(str"):
+        new_order(build_estimator, "sun2011", "ekf")
 
 
 def test_engine_resolve_estimator_and_estimators():

@@ -82,13 +82,16 @@ def scenario_moved(*old_order: str, was: type | tuple[type, ...] | Callable[[Any
     was : type, tuple of types or callable
         What the earlier first argument is (e.g. ``str`` for a registry name,
         ``callable`` for a builder): a call whose first positional argument is
-        an instance of it (or for which the predicate holds) is in the earlier
-        order. A scenario must never match it.
+        an instance of it (or for which the predicate holds) and whose second
+        is not is in the earlier order. A scenario must never match it; when
+        both match (e.g. a scenario wrongly given as a name), the call is read
+        in the present order, so the function's own check names the scenario.
     **fill
         As in :func:`accepts_old_order`.
     """
     test = (lambda value: isinstance(value, was)) if isinstance(was, (type, tuple)) else was
-    return accepts_old_order(old_order, lambda args, kwargs: not args or not test(args[0]), fill=fill)
+    return accepts_old_order(old_order, lambda args, kwargs: not (args and test(args[0]) and not (len(args) > 1 and test(args[1]))),
+                             fill=fill)
 
 
 def scenario_keyword(*old_order: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
