@@ -81,7 +81,7 @@ def batched_vs_run_by_run(estimators, runs, steps, sample):
         if name not in known:
             print(f"{name:<32}  not registered for the chaser (its paper may not be importable yet)")
             continue
-        est = build_estimator(name, scenario)
+        est = build_estimator(scenario, name)
         wall, cpu = _timed(lambda: est.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False))
         one = [_timed(lambda r=r: est.estimate(truth.y[r:r + 1], truth.u[r:r + 1], scenario.xhat0,
                                                keep_covariance=False))[0] for r in range(sample)]

@@ -58,12 +58,12 @@ def main(argv=None):
     sc = Scenario(duration_s=args.steps * 0.1, rms_window_s=(0.0, args.steps * 0.1))
     truth = simulate_truth(sc.truth_model(maneuver=True), runs=1, seed=0)
     y, u, x0 = truth.y, truth.u, sc.xhat0
-    ekf = build_estimator("ekf_known_input", sc)
+    ekf = build_estimator(sc, "ekf_known_input")
     filters = {
         "ekf": ekf,
         "huber": HuberFilter.from_ekf(ekf),
-        "strong tracking": build_estimator("ekf_augmented_thrust_st", sc),
-        "recursive hinf": build_estimator("recursive_hinf", sc),
+        "strong tracking": build_estimator(sc, "ekf_augmented_thrust_st"),
+        "recursive hinf": build_estimator(sc, "recursive_hinf"),
     }
     print(f"Sun 2011 chaser, 1 run, {y.shape[1]} steps: µs per step of update + predict (best of {args.repeat})")
     print(f"{'filter':18}{'hooks (before)':>16}{'public (after)':>16}{'checks':>10}")

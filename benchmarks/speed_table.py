@@ -168,13 +168,13 @@ def _filterpy_ukf(ukf, y, u, x0):
 
 def filters(sc):
     """The table's filters: name → (estimator, filterpy loop or None, flop kind, shares its gain)."""
-    ekf = build_estimator("ekf_known_input", sc)
+    ekf = build_estimator(sc, "ekf_known_input")
     return {
         "EKF": (ekf, _filterpy_ekf, "shared", True),
-        "sigma-point (UKF)": (build_estimator("ukf", sc), _filterpy_ukf, "ukf", False),
+        "sigma-point (UKF)": (build_estimator(sc, "ukf"), _filterpy_ukf, "ukf", False),
         "Huber": (HuberFilter.from_ekf(ekf), None, "huber", False),
-        "strong tracking": (build_estimator("ekf_augmented_thrust_st", sc), None, "strong", False),
-        "recursive H∞": (build_estimator("recursive_hinf", sc), None, "shared", True),
+        "strong tracking": (build_estimator(sc, "ekf_augmented_thrust_st"), None, "strong", False),
+        "recursive H∞": (build_estimator(sc, "recursive_hinf"), None, "shared", True),
     }
 
 
@@ -186,7 +186,7 @@ from hinfnav.papers.sun2011 import Scenario
 from hinfnav.sim import simulate_truth
 sc = Scenario(duration_s=2.0, rms_window_s=(0.0, 2.0))
 t = simulate_truth(sc.truth_model(maneuver=True), runs=1, seed=0)
-ests = [build_estimator(n, sc) for n in ('ekf_known_input', 'ukf', 'recursive_hinf', 'ekf_augmented_thrust_st')]
+ests = [build_estimator(sc, n) for n in ('ekf_known_input', 'ukf', 'recursive_hinf', 'ekf_augmented_thrust_st')]
 ests.append(HuberFilter.from_ekf(ests[0]))
 c1, w1 = time.process_time(), time.perf_counter()
 for est in ests:

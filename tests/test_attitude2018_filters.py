@@ -129,7 +129,7 @@ def test_thrust_augmentation_fixes_the_first_500_s_of_the_maneuver():
     truth = hn.simulate_truth(sc.truth_model(maneuver=True), runs=2, seed=0)
     err = {}
     for name in ("ekf",) + CHASER_FILTERS:
-        est = hn.build_estimator(name, sc) if name == "ekf" else build_augmented_thrust(sc, name.split("thrust")[1][1:] or "plain")
+        est = hn.build_estimator(sc, name) if name == "ekf" else build_augmented_thrust(sc, name.split("thrust")[1][1:] or "plain")
         res = hn.sim.run_estimator(est, truth, sc.xhat0)
         err[name] = float(np.sqrt(np.mean(hn.rms_error(res.error, res.t, (0.0, 500.0))[:3] ** 2)))
     assert err["ekf"] > 0.8

@@ -163,7 +163,7 @@ API_ROWS = [
     # was: accepted and silently ignored
     _row("published-option", lambda c: sun.make_estimator(SHORT, "published", delta_bar=0.3), r"\bdelta_bar\b"),
     # was: TypeError unhashable type
-    _row("build_estimator-list", lambda c: hn.build_estimator(["ekf"], SHORT), r"\bfilter\b"),
+    _row("build_estimator-list", lambda c: hn.build_estimator(SHORT, ["ekf"]), r"\bfilter\b"),
     # was: accepted, failing later with TypeError
     _row("register-builder-int", lambda c: hn.register_estimator("test_bad_builder", 5), r"\bbuilder\b"),
     _row("lti-unstable-A_F", lambda c: hn.LTIFilter(3 * np.eye(6), np.zeros((6, 3)), np.eye(6), SHORT.system(),

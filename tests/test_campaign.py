@@ -91,7 +91,7 @@ def counting():
                 raise KeyboardInterrupt  # what Ctrl-C does in the middle of a campaign
             return self.inner.estimate(*args, **kwargs)
 
-    register_estimator("test_counting", lambda sc, **kw: Counting(build_estimator("published", sc)),
+    register_estimator("test_counting", lambda sc, **kw: Counting(build_estimator(sc, "published")),
                        fits=lambda sc: isinstance(sc, Scenario))
     yield calls
     _REGISTRY.pop("test_counting", None)
@@ -181,7 +181,7 @@ def test_benchmark_limits_and_table():
     camp = benchmark_campaign(runs=200, estimators=["published", "ekf", "hbf"])
     assert len(camp.cells()) == 3 * 24  # every estimator on every cell: 2 maneuvers x 3 deltas x 4 noises (issue 13)
     spec = _spec(grid={"delta": [0.0, 1.0]}, windows={"early": [0.0, 10.0], "steady": [5.0, 20.0]})
-    table = benchmark_table(run_campaign(spec, client="serial", progress=False), Scenario())
+    table = benchmark_table(run_campaign(spec, client="serial", progress=False), scenario=Scenario())
     assert len(table) == 16 and np.all(table["pos_steady_ratio"] > 0)
     assert "| `published` |" in format_markdown(table)
 

@@ -43,10 +43,10 @@ def test_the_five_families_on_the_scenarios_and_the_lmi_designs_only_where_linea
     for key in ("shi2018", "yang2020"):
         assert {"model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_adaptive"} <= fits[key]
     # the generic sigma-point filter (additive error) on the quaternion state: not fitting, with the reason
-    assert "quaternion" in fit_reason("ukf", build_scenario("attitude2018"))
+    assert "quaternion" in fit_reason(build_scenario("attitude2018"), "ukf")
     assert "designed" in fits["sun2011"] and not any("designed" in fits[k] for k in ("shi2018", "attitude2018", "yang2020"))
     with pytest.raises(InputError, match="does not fit"):
-        build_estimator("model_ekf", build_scenario("attitude2018"))
+        build_estimator(build_scenario("attitude2018"), "model_ekf")
 
 
 def test_shi_truth_draws_do_not_depend_on_the_batch_and_the_maneuver_is_the_only_difference():
@@ -94,7 +94,7 @@ def test_attitude_sigma_point_filter_matches_the_aekf_at_small_errors():
     truth = cell_truth(sc, {}, "gaussian", seed=3, runs=3)
     err = {}
     for name in ("aekf", "attitude_ukf"):
-        xh = build_estimator(name, sc).estimate(truth.y, truth.u, sc.xhat0).xhat
+        xh = build_estimator(sc, name).estimate(truth.y, truth.u, sc.xhat0).xhat
         e = rotvec_from_quat(quat_multiply(truth.x[..., :4], quat_conjugate(xh[..., :4])))
         err[name] = np.sqrt(np.mean(e[:, truth.t >= truth.t[-1] / 2] ** 2))
     assert err["attitude_ukf"] == pytest.approx(err["aekf"], rel=1e-2)

@@ -67,7 +67,7 @@ def _scenario(name):
 @functools.cache
 def _built(name, on_sun=False):
     """The registered estimator on its own scenario (or the chaser's), built once for the module (designs cost)."""
-    return build_estimator(name, SUN if on_sun else _scenario(name))
+    return build_estimator(SUN if on_sun else _scenario(name), name)
 
 
 @pytest.fixture(scope="module")
@@ -140,7 +140,7 @@ def test_no_kernel_refuses_numba_and_auto_runs_numpy(name):
 
 def test_backend_options_checked(chaser_truth):
     y, u = chaser_truth
-    est = build_estimator("hbf", SUN)
+    est = build_estimator(SUN, "hbf")
     with pytest.raises(hn.InputError, match="backend"):
         est.estimate(y, u, SUN.xhat0, backend="fortran")
     with pytest.raises(hn.InputError, match="diagnostics"):

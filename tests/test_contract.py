@@ -70,21 +70,21 @@ def _truth(key, make):
 
 def make_case(name):
     if name in registered_estimators(SCENARIO):
-        est = build_estimator(name, SCENARIO)
+        est = build_estimator(SCENARIO, name)
         truth = _truth("sun2011", lambda: simulate_truth(SCENARIO.truth_model(maneuver=True), runs=3, seed=7))
         return Case(name, "sun2011", SCENARIO, est, truth,
                     lambda e, **kw: hn.simulate(SCENARIO, e, maneuver=True, **kw))
     if name in registered_estimators(SHI):
-        est = build_estimator(name, SHI)
+        est = build_estimator(SHI, name)
         truth = _truth("shi2018", lambda: simulate_truth(SHI.truth_model(), runs=3, seed=7))
         return Case(name, "shi2018", SHI, est, truth, lambda e, **kw: hn.simulate(SHI, e, **kw))
     if name in registered_estimators(ATTITUDE):
-        est = build_estimator(name, ATTITUDE)
+        est = build_estimator(ATTITUDE, name)
         truth = _truth("attitude2018", lambda: simulate_nonlinear_truth(ATTITUDE.truth_model(), runs=3, seed=11))
         return Case(name, "attitude2018", ATTITUDE, est, truth, lambda e, **kw: simulate_nonlinear(ATTITUDE, e, **kw))
     lt = YANG.linear_truth(SUBSYSTEM_OF[name])
     truth = _truth(name, lambda: simulate_truth(lt.truth_model(), runs=3, seed=7))
-    return Case(name, "yang2020", lt, build_estimator(name, lt), truth, lambda e, **kw: hn.simulate(lt, e, **kw))
+    return Case(name, "yang2020", lt, build_estimator(lt, name), truth, lambda e, **kw: hn.simulate(lt, e, **kw))
 
 
 @pytest.fixture(scope="module", params=NAMES)
@@ -107,7 +107,7 @@ def test_yang2020_registered_for_the_paper_and_only_there():
     assert not set(YANG_NAMES) & set(registered_estimators(Scenario()))
     assert registered_estimators(YANG.linear_truth("position")) == ("yang2020_alg1",)
     with pytest.raises(hn.InputError, match="does not fit"):
-        build_estimator("yang2020_fused", Scenario())
+        build_estimator(Scenario(), "yang2020_fused")
 
 
 def test_shapes_and_labels(case):
@@ -169,7 +169,7 @@ def test_converges_without_noise_on_a_stable_problem(case):
     if case.paper == "sun2011":
         # with maneuver the closed loop is stable; without noise every filter's error must vanish
         sc = Scenario(duration_s=1500.0, rms_window_s=(1400.0, 1500.0))
-        est = build_estimator(case.name, sc)
+        est = build_estimator(sc, case.name)
         res = hn.simulate(sc, est, runs=1, seed=0, noise=ZeroNoise(), maneuver=True)
         final = np.abs(res.error[0, -1])
         # limit 0 (no noise); 1 mm and 1 mm/s leave room for the slowest transient (the unaware EKF's)
@@ -195,7 +195,7 @@ def test_converges_without_noise_on_a_stable_problem(case):
     elif case.paper == "attitude2018":
         # limit 0: no measurement noise, a negligible torque (T0 = 1e-12 N m); initial errors ~1e-2 rad
         sc = AttitudeScenario(orbits=0.1, T0=1e-12)
-        res = simulate_nonlinear(sc, build_estimator(case.name, sc), runs=1, noise=ZeroNoise())
+        res = simulate_nonlinear(sc, build_estimator(sc, case.name), runs=1, noise=ZeroNoise())
         e = np.abs(res.error[0, -1])
         assert np.all(e[:3] < 1e-9) and np.all(e[3:6] < 1e-10) and np.all(e[6:] < 1e-11), (case.name, e)
     else:
@@ -223,10 +223,10 @@ def test_bad_input_names_the_parameter(case, change, word):
 def test_saturation_flags_in_the_diagnostics():
     lt = YANG.linear_truth("dragfree")
     tr = simulate_truth(lt.truth_model(disturbance=-12.8e-3, feedback=False, n_steps=50), runs=1, seed=0)
-    hist = build_estimator("yang2020_alg2", lt).estimate(tr.y, tr.u, lt.xhat0, diagnostics=True)
+    hist = build_estimator(lt, "yang2020_alg2").estimate(tr.y, tr.u, lt.xhat0, diagnostics=True)
     np.testing.assert_array_equal(hist.diagnostics["saturated"], tr.y <= -6e-6)
 
 
 def test_unknown_name_lists_the_registered_ones():
     with pytest.raises(hn.InputError, match="published"):
-        build_estimator("kalmann", SCENARIO)
+        build_estimator(SCENARIO, "kalmann")

@@ -41,8 +41,8 @@ def test_hbf_is_the_kalman_filter_on_sun2011_when_gamma_is_huge():
     # Same identity on Sun 2011's chaser (linear position measurement, shared EKF covariance).
     sc = sun2011.Scenario(duration_s=20.0, rms_window_s=(5.0, 20.0))
     tr = hn.simulate_truth(sc.truth_model(maneuver=True), runs=2, seed=3)
-    ekf = build_estimator("ekf_known_input", sc)
-    hbf = build_estimator("hbf", sc, gamma=1e9)
+    ekf = build_estimator(sc, "ekf_known_input")
+    hbf = build_estimator(sc, "hbf", gamma=1e9)
     assert isinstance(hbf, HuberFilter) and hbf.uses_input and not hbf.shares_covariance
     a = ekf.estimate(tr.y, tr.u, sc.xhat0).xhat
     b = hbf.estimate(tr.y, tr.u, sc.xhat0).xhat

@@ -181,9 +181,9 @@ _CHEAP = [n for n in registered_estimators() if n not in _NOT_PREDICT_ONLY]
 def _build(name):
     for sc in _SCENARIOS:
         if name in registered_estimators(sc):
-            return build_estimator(name, sc), np.asarray(sc.xhat0, dtype=float)
+            return build_estimator(sc, name), np.asarray(sc.xhat0, dtype=float)
     sc = _YANG.linear_truth(SUBSYSTEM_OF[name])
-    return build_estimator(name, sc), np.asarray(sc.xhat0, dtype=float)
+    return build_estimator(sc, name), np.asarray(sc.xhat0, dtype=float)
 
 
 @pytest.mark.parametrize("name", _CHEAP)

@@ -137,7 +137,7 @@ def test_existence_condition_checked_every_step():
 
 def test_steady_gain_on_the_chaser_is_the_steady_state_hinf(short_scenario):
     # the registered filter's P after its recursion has converged equals steady_state_hinf's (same θ)
-    est = build_estimator("recursive_hinf", short_scenario)
+    est = build_estimator(short_scenario, "recursive_hinf")
     theta_max = max_admissible_theta(est.F, est.H, est.Q, est.R)
     assert est.theta == pytest.approx(0.5 * theta_max, rel=1e-12)
     P_ss, K_ss = steady_state_hinf(est.F, est.H, est.Q, est.R, est.theta)

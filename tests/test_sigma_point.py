@@ -194,11 +194,11 @@ def test_registered_for_the_papers_that_name_it():
     shi = shi2018.Scenario()
     assert "ukf" in registered_estimators(chaser) and "ukf" in registered_estimators(shi)
     truth = hn.simulate_truth(chaser.truth_model(maneuver=True), runs=2, seed=1)
-    a = build_estimator("ukf", chaser).estimate(truth.y, truth.u, chaser.xhat0)
-    b = build_estimator("ekf_known_input", chaser).estimate(truth.y, truth.u, chaser.xhat0)
+    a = build_estimator(chaser, "ukf").estimate(truth.y, truth.u, chaser.xhat0)
+    b = build_estimator(chaser, "ekf_known_input").estimate(truth.y, truth.u, chaser.xhat0)
     # linear dynamics and measurement: the unscented transform is exact, UKF = Kalman filter to rounding
     np.testing.assert_allclose(a.xhat, b.xhat, rtol=0, atol=1e-9)
-    ukf = build_estimator("ukf", shi)
+    ukf = build_estimator(shi, "ukf")
     assert isinstance(ukf, SigmaPointFilter) and ukf.measurement.labels == ("range", "azimuth", "elevation")
 
 

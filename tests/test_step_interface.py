@@ -39,7 +39,7 @@ def built(name):
     """``(estimator, xhat0)`` built once per test module."""
     if name not in _BUILT:
         sc = scenario_for(name)
-        _BUILT[name] = build_estimator(name, sc), np.asarray(sc.xhat0, dtype=float)
+        _BUILT[name] = build_estimator(sc, name), np.asarray(sc.xhat0, dtype=float)
     return _BUILT[name]
 
 

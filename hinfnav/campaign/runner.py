@@ -95,7 +95,7 @@ def _estimator(scenario, name, settings, est, options):
     if key not in _BUILT:
         if len(_BUILT) >= _MAX_BUILT:
             _BUILT.clear()
-        _BUILT[key] = build_estimator(est, scenario, **options)
+        _BUILT[key] = build_estimator(scenario, est, **options)
     return _BUILT[key]
 
 

@@ -324,7 +324,7 @@ class Campaign:
             except InputError:
                 raise InputError(f"grid.estimator: unknown estimator {name!r}; registered: "
                                  f"{', '.join(registered_estimators())}") from None
-            why = fit_reason(entry.name, scenario)
+            why = fit_reason(scenario, entry.name)
             if why is not None:
                 raise InputError(f"grid.estimator: {name!r} does not fit scenario {scenario_name!r} ({why}); these do: "
                                  f"{', '.join(registered_estimators(scenario))}")

@@ -22,7 +22,7 @@ from typing import Any
 
 from .exceptions import InputError
 
-__all__ = ["UNTIL", "accepts_old_order", "renamed_keywords", "translate_keywords"]
+__all__ = ["UNTIL", "accepts_old_order", "scenario_moved", "scenario_keyword", "renamed_keywords", "translate_keywords"]
 
 #: The release that drops the earlier names.
 UNTIL = "0.3"
@@ -79,6 +79,35 @@ def accepts_old_order(old_order: Sequence[str], is_new: Callable[[tuple, dict], 
         return wrapper
 
     return decorate
+
+
+def scenario_moved(*old_order: str, was: type | tuple[type, ...] | Callable[[Any], bool],
+                   **fill: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Decorator of a function whose scenario moved to the front from its place in ``old_order``.
+
+    Parameters
+    ----------
+    *old_order : str
+        The positional parameters in their earlier order.
+    was : type, tuple of types or callable
+        What the earlier first argument is (e.g. ``str`` for a registry name,
+        ``callable`` for a builder): a call whose first positional argument is
+        an instance of it (or for which the predicate holds) and whose second
+        is not is in the earlier order. A scenario must never match it; when
+        both match (e.g. a scenario wrongly given as a name), the call is read
+        in the present order, so the function's own check names the scenario.
+    **fill
+        As in :func:`accepts_old_order`.
+    """
+    test = (lambda value: isinstance(value, was)) if isinstance(was, (type, tuple)) else was
+    return accepts_old_order(old_order, lambda args, kwargs: not (args and test(args[0]) and not (len(args) > 1 and test(args[1]))),
+                             fill=fill)
+
+
+def scenario_keyword(*old_order: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Decorator of a function whose optional scenario, at its place in ``old_order``, became keyword-only."""
+    n = old_order.index("scenario")
+    return accepts_old_order(old_order, lambda args, kwargs: len(args) <= n)
 
 
 def translate_keywords(owner: str, renamed: Mapping[str, str], kwargs: Mapping[str, Any], *,

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from typing import TYPE_CHECKING, Any
 
+from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 
 if TYPE_CHECKING:
@@ -180,7 +181,8 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description, requires)
 
 
-def fit_reason(name: str, scenario: Any) -> str | None:
+@scenario_moved("name", "scenario", was=str)
+def fit_reason(scenario: Any, name: str) -> str | None:
     """Why the estimator ``name`` does not fit ``scenario`` (None: it fits).
 
     A scenario with ``offers`` (:class:`Offers`) is checked against the
@@ -203,7 +205,7 @@ def registered_estimators(scenario: Any = None) -> tuple[str, ...]:
     The first call loads the providers (:func:`load_providers`), so the list is complete in a fresh process.
     """
     _ensure_providers()
-    return tuple(n for n in tuple(_REGISTRY) if scenario is None or fit_reason(n, scenario) is None)
+    return tuple(n for n in tuple(_REGISTRY) if scenario is None or fit_reason(scenario, n) is None)
 
 
 def estimator_entry(name: str) -> _Entry:
@@ -215,10 +217,11 @@ def estimator_entry(name: str) -> _Entry:
     return _REGISTRY[name]
 
 
-def build_estimator(name: str, scenario: Any, **options: Any) -> Estimator:
+@scenario_moved("name", "scenario", was=str)
+def build_estimator(scenario: Any, name: str, **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``."""
     entry = estimator_entry(name)
-    why = fit_reason(name, scenario)
+    why = fit_reason(scenario, name)
     if why is not None:
         fitting = ", ".join(registered_estimators(scenario))
         raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "

@@ -92,7 +92,7 @@ def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | Synthesis
         when the filter is flagged ``diverged``.
     """
     sink = StatisticsSink(windows, runs, scenario.xhat0, tol)
-    est = resolve_estimator(estimator, scenario)
+    est = resolve_estimator(scenario, estimator)
     acc = run_monte_carlo(scenario, {est.name: est}, sink=sink, runs=runs, seed=seed, batch_size=batch_size,
                           noise=noise, measurement_noise=measurement_noise, keep_covariance=True,
                           diagnostics=NIS_KEYS, progress=progress, **conditions)[est.name]

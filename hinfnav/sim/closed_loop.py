@@ -64,7 +64,7 @@ def simulate_closed_loop(scenario: Any, estimator: str | Estimator | SynthesisRe
     """
     if controller is not None and not isinstance(controller, LinearFeedback):
         raise InputError(f"controller must be a hinfnav LinearFeedback; got {type(controller).__name__}")
-    estimator = resolve_estimator(estimator, scenario)
+    estimator = resolve_estimator(scenario, estimator)
     out = run_monte_carlo(scenario, {estimator.name: estimator}, sink=HistorySink(scenario.xhat0, runs), runs=runs,
                           seed=seed, batch_size=batch_size, noise=noise, measurement_noise=measurement_noise,
                           controller=controller, closed_loop=True, P0=P0, keep_covariance=keep_covariance,

@@ -36,6 +36,7 @@ of one batch, whatever the runs).
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
@@ -45,6 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
+from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
@@ -93,16 +95,22 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
     return seed
 
 
-def resolve_estimator(estimator: str | Estimator | SynthesisResult, scenario: Any) -> Estimator:
-    """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a
-    name for ``scenario``, or built from a design.
+def _names_estimators(value: Any) -> bool:
+    """Whether ``value`` is what came first in ``resolve_estimator(s)``'s earlier order: estimators, never a scenario."""
+    design = getattr(sys.modules.get("hinfnav.design.result"), "SynthesisResult", ())  # no design without its module
+    return isinstance(value, (str, Estimator, Mapping, Sequence, design))
+
+
+@scenario_moved("estimator", "scenario", was=_names_estimators)
+def resolve_estimator(scenario: Any, estimator: str | Estimator | SynthesisResult) -> Estimator:
+    """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a name for ``scenario``, or built from a design.
 
     A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
     the scenario's ``estimator_from_design`` (which checks that it was
     designed for this scenario's sampling time).
     """
     if isinstance(estimator, str):
-        return build_estimator(estimator, scenario)
+        return build_estimator(scenario, estimator)
     if estimator is None:
         raise InputError("estimator must be given (an Estimator or a registered filter name such as 'published')")
     if _estimator_like(estimator):
@@ -123,7 +131,8 @@ def _estimator_like(obj: Any) -> bool:
     return isinstance(obj, Estimator) or (callable(getattr(obj, "estimate", None)) and hasattr(obj, "measurement"))
 
 
-def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
+@scenario_moved("estimators", "scenario", was=_names_estimators)
+def resolve_estimators(scenario: Any, estimators: Any) -> dict[str, Estimator]:
     """Name → Estimator from one estimator, a sequence of them, or a mapping name → estimator (names unique)."""
     if isinstance(estimators, Mapping):
         items = [(str(k), v) for k, v in estimators.items()]
@@ -135,7 +144,7 @@ def resolve_estimators(estimators: Any, scenario: Any) -> dict[str, Estimator]:
         raise InputError("estimators must hold at least one estimator")
     out = {}
     for key, e in items:
-        est = resolve_estimator(e, scenario)
+        est = resolve_estimator(scenario, e)
         name = getattr(est, "name", type(est).__name__) if key is None else key
         if name in out:
             raise InputError(f"estimators: the name {name!r} is given twice; pass a mapping name -> estimator")
@@ -328,7 +337,7 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
     -------
     ``sink.result()``
     """
-    ests = resolve_estimators(estimators, scenario)
+    ests = resolve_estimators(scenario, estimators)
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
     seed = plain_seed(seed)

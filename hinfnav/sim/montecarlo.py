@@ -75,7 +75,7 @@ def simulate_batches(scenario: Any, estimator: str | Estimator | SynthesisResult
     Arguments as in :func:`simulate`. (The engine's pull form: :func:`hinfnav.sim.engine.truth_batches`
     and :func:`~hinfnav.sim.engine.estimate_on_truth`.)
     """
-    estimator = resolve_estimator(estimator, scenario)
+    estimator = resolve_estimator(scenario, estimator)
     xhat0 = np.asarray(scenario.xhat0, dtype=float)
     for start, truth in truth_batches(scenario, conditions, runs=runs, batch_size=batch_size, seed=seed, noise=noise,
                                       measurement_noise=measurement_noise):
@@ -163,7 +163,7 @@ def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noi
     """
     if not callable(getattr(scenario, "simulate_truth", None)):
         check_history_memory(scenario, runs, **conditions)
-    estimator = resolve_estimator(estimator, scenario)
+    estimator = resolve_estimator(scenario, estimator)
     out = run_monte_carlo(scenario, {estimator.name: estimator}, sink=HistorySink(scenario.xhat0, runs), runs=runs,
                           seed=seed, batch_size=batch_size, noise=noise, measurement_noise=measurement_noise,
                           keep_covariance=keep_covariance, diagnostics=diagnostics, progress=progress, **conditions)

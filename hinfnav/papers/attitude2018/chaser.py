@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.deprecation import renamed_keywords
 from ...core.validation import as_choice, as_int_at_least
@@ -176,7 +177,8 @@ def _stats(res):
     return {f"{int(w[0])}-{int(w[1])}": window_stats(res.error, res.t, res.state, w) for w in WINDOWS}
 
 
-def run_passes(builder, passes, scenario, *, diagnostics=()):
+@scenario_moved("builder", "passes", "scenario", was=callable)
+def run_passes(scenario, builder, passes, *, diagnostics=()):
     """Several passes of one filter, each ``(truth, params)``, as one batch over all their runs.
 
     A pass costs mostly its per-step Python overhead, nearly the same for 4 runs as for 56 (measured,
@@ -248,7 +250,7 @@ def chaser_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, progress=Fa
         name = build_augmented_thrust(scenario, variant).name
         builder = functools.partial(build_augmented_thrust, variant=variant)
         passes = [(truth, {key: default})] + [(small, {key: v}) for v in values]
-        errors, hist = run_passes(builder, passes, scenario, diagnostics=True)
+        errors, hist = run_passes(scenario, builder, passes, diagnostics=True)
         rows[name] = {f"{int(w[0])}-{int(w[1])}": window_stats(errors[0], truth.t, truth.state, w) for w in WINDOWS}
         runs0[name] = SimulationResult(t=truth.t, x=truth.x[:1], xhat=hist.xhat[:1], u=truth.u[:1], y=truth.y[:1], P=None,
                                        settings=dict(truth.settings, filter=name), state=truth.state,

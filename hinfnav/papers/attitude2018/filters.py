@@ -20,6 +20,7 @@ three Sun 2011's scenario only.
 
 import numpy as np
 
+from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.deprecation import renamed_keywords
 from ...estimators.attitude import AttitudeAAEKF, AttitudeAEKF, AttitudeASTEKF
@@ -87,7 +88,8 @@ def build_aaekf(scenario, Q0=DEFAULT_AA["Q0"], *, epsilon=None, memory_steps=DEF
 _BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}
 
 
-def build_attitude_filter(name, scenario, **options):
+@scenario_moved("name", "scenario", was=str)
+def build_attitude_filter(scenario, name, **options):
     """One of :data:`ATTITUDE_FILTERS` by name."""
     if name not in _BUILDERS:
         raise InputError(f"unknown attitude filter {name!r}; choose one of: {', '.join(_BUILDERS)}")

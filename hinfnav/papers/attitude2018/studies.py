@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
+from ...core.deprecation import scenario_moved
 from ...core.validation import as_int_at_least
 from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
@@ -160,7 +161,8 @@ def _elasticity(b, rate, low=0.5):
     return out
 
 
-def filter_stats(label, error, t, scenario, *, params=None, keep=False, diagnostics=None):
+@scenario_moved("label", "error", "t", "scenario", was=str)
+def filter_stats(scenario, label, error, t, *, params=None, keep=False, diagnostics=None):
     """Reduce an error history (runs, n_samples, 9) to :class:`FilterStats` over the scenario's window."""
     mask = window_mask(t, scenario.rms_window_s)
     e = error[:, mask]
@@ -215,15 +217,17 @@ def first_runs(truth, k):
                  state=truth.state, measurement=truth.measurement)
 
 
-def run_filter(label, estimator, truth, scenario, *, params=None, keep=False, diagnostics=()):
+@scenario_moved("label", "estimator", "truth", "scenario", was=str)
+def run_filter(scenario, label, estimator, truth, *, params=None, keep=False, diagnostics=()):
     """One pass of an estimator over every run of ``truth``, reduced to :class:`FilterStats`."""
     hist = estimator.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False,
                               diagnostics=tuple(diagnostics) if keep else ())
     err = truth.state.error(truth.x, hist.xhat)
-    return filter_stats(label, err, truth.t, scenario, params=params, keep=keep, diagnostics=hist.diagnostics)
+    return filter_stats(scenario, label, err, truth.t, params=params, keep=keep, diagnostics=hist.diagnostics)
 
 
-def run_batched(builder, key, values, truth, scenario, *, labels=None, keep=False, extra=None, **fixed):
+@scenario_moved("builder", "key", "values", "truth", "scenario", was=callable)
+def run_batched(scenario, builder, key, values, truth, *, labels=None, keep=False, extra=None, **fixed):
     """A parameter sweep as one pass: ``builder(scenario, **{key: per-run values}, **fixed)`` over the repeated truth.
 
     ``key`` may be a tuple of names with ``values`` a sequence of tuples. ``extra``
@@ -246,21 +250,21 @@ def run_batched(builder, key, values, truth, scenario, *, labels=None, keep=Fals
         err = truth.state.error(truth.x, xhat[i * R:(i + 1) * R])
         params = dict(zip(keys, v))
         label = labels[i] if labels else ", ".join(f"{k}={x:g}" for k, x in params.items())
-        out.append(filter_stats(label, err, truth.t, scenario, params=params, keep=keep))
+        out.append(filter_stats(scenario, label, err, truth.t, params=params, keep=keep))
     return out
 
 
-def _main_and_sweeps(builder, key, diag, truth, main_params, sweeps, scenario, eps0):
+def _main_and_sweeps(scenario, builder, key, diag, truth, main_params, sweeps, eps0):
     """The main runs of one filter (histories kept) and its sweeps, one pass; returns (main stats, [sweep stats]).
 
     ``sweeps``: ``(truth, run parameters, recorded parameters, label, keep histories)`` per sweep value.
     """
     passes = [(truth, main_params)] + [(small, params) for small, params, _, _, _ in sweeps]
-    errors, hist = run_passes(builder, passes, scenario, diagnostics=diag)
+    errors, hist = run_passes(scenario, builder, passes, diagnostics=diag)
     diagnostics = hist.diagnostics
-    main = filter_stats(key, errors[0], truth.t, scenario, params=dict(est_params(key, eps0)), keep=True,
+    main = filter_stats(scenario, key, errors[0], truth.t, params=dict(est_params(key, eps0)), keep=True,
                         diagnostics=diagnostics)
-    out = [filter_stats(label, err, small.t, scenario, params=record, keep=keep)
+    out = [filter_stats(scenario, label, err, small.t, params=record, keep=keep)
            for err, (small, _, record, label, keep) in zip(errors[1:], sweeps)]
     return main, out
 
@@ -328,23 +332,23 @@ def attitude_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, Qs=Q_SWEE
     main = {}
     # each filter's main runs and its sweeps in one pass (run_passes): the numbers of separate passes
     q_sweep = [(small, {"Q": q}, {"Q": q}, label, True) for q, label in zip(Qs, labels)]
-    main["aekf"], sweep["aekf"] = _main_and_sweeps(build_aekf, "aekf", (), truth, {"Q": PAPER_Q_BEST_AEKF}, q_sweep,
-                                                   scenario, eps0)
+    main["aekf"], sweep["aekf"] = _main_and_sweeps(scenario, build_aekf, "aekf", (), truth, {"Q": PAPER_Q_BEST_AEKF},
+                                                   q_sweep, eps0)
     bar.update(2)
     st = dict(Q=PAPER_Q_ASTEKF, rho=DEFAULT_ST["rho"], beta=DEFAULT_ST["beta"])
     st_sweeps = [(small, dict(st, Q=q), {"Q": q}, label, True) for q, label in zip(Qs, labels)]
     st_sweeps += [(small, dict(st, rho=r, beta=b), {"rho": r, "beta": b}, f"rho={r:g}, beta={b:g}", False)
                   for r, b in ST_GRID]
-    main["astekf"], st_out = _main_and_sweeps(build_astekf, "astekf", ("fading", "fading_c"), truth, st, st_sweeps,
-                                              scenario, eps0)
+    main["astekf"], st_out = _main_and_sweeps(scenario, build_astekf, "astekf", ("fading", "fading_c"), truth, st,
+                                              st_sweeps, eps0)
     sweep["astekf"], st_grid = st_out[:len(Qs)], st_out[len(Qs):]
     bar.update(3)
     eps_sweeps = [(small, {"epsilon": f * eps0}, {"epsilon": f * eps0}, f"ε={f:g}×default", False)
                   for f in EPSILON_FACTORS]
-    main["aaekf"], eps_sweep = _main_and_sweeps(build_aaekf, "aaekf", ("q_adapted", "input_rate"), truth,
-                                                {"epsilon": eps0}, eps_sweeps, scenario, eps0)
+    main["aaekf"], eps_sweep = _main_and_sweeps(scenario, build_aaekf, "aaekf", ("q_adapted", "input_rate"), truth,
+                                                {"epsilon": eps0}, eps_sweeps, eps0)
     bar.update(2)
-    win_sweep = [run_filter(f"m={m}", build_aaekf(scenario, epsilon=eps0, memory_steps=m), small, scenario, params={"window": m})
+    win_sweep = [run_filter(scenario, f"m={m}", build_aaekf(scenario, epsilon=eps0, memory_steps=m), small, params={"window": m})
                  for m in WINDOW_VALUES]
     bar.update(1)
     bar.close()
@@ -367,7 +371,7 @@ def sweep_study(scenario=None, *, runs=2, seed=0, filters=("aekf",), Qs=Q_SWEEP)
     builders = {"aekf": build_aekf, "astekf": build_astekf}
     sweep = {"Q": Qs}
     for name in filters:
-        sweep[name] = run_batched(builders[name], "Q", Qs, truth, scenario, labels=labels, keep=True)
+        sweep[name] = run_batched(scenario, builders[name], "Q", Qs, truth, labels=labels, keep=True)
     settings = {"runs": runs, "sweep_runs": runs, "seed": seed, "rms_window_s": list(scenario.rms_window_s)}
     return AttitudeStudy(scenario=scenario, truth_t=truth.t, main={}, q_sweep=sweep, st_grid=[], epsilon_sweep=[],
                          window_sweep=[], settings=settings)

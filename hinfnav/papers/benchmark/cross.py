@@ -13,6 +13,7 @@ draws one scenario's ratios.
 import numpy as np
 import pandas as pd
 
+from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure
 
@@ -102,7 +103,8 @@ def winners(table):
     return out
 
 
-def plot_scenario_heatmap(table, scenario, *, axes=None):
+@scenario_moved("table", "scenario", was=pd.DataFrame)
+def plot_scenario_heatmap(scenario, table, *, axes=None):
     """Heat map of log₁₀(RMS/bound) of one scenario: estimators × conditions, one panel per quantity.
 
     Returns

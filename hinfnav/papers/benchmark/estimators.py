@@ -26,6 +26,7 @@ sigma-point and a Huber filter beside its AEKF, ASTEKF and AAEKF.
 
 import numpy as np
 
+from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...estimators.attitude import AttitudeHuberEKF
 from ...estimators.augmented import AugmentedInputAdaptiveKF
@@ -61,7 +62,8 @@ def _model(scenario):
     raise InputError(f"scenario {type(scenario).__name__} offers no kalman_model()")
 
 
-def build_generic(kind, scenario, **options):
+@scenario_moved("kind", "scenario", was=str)
+def build_generic(scenario, kind, **options):
     """One of the five filters of the module table on ``scenario``'s Kalman model (``options`` to its class)."""
     m = _model(scenario)
     system, meas, P0 = m["system"], m["measurement"], m["P0"]
@@ -88,7 +90,7 @@ def build_generic(kind, scenario, **options):
 
 def _builder(kind):
     def build(scenario, **options):
-        return build_generic(kind, scenario, **options)
+        return build_generic(scenario, kind, **options)
 
     build.__name__ = f"build_model_{kind}"
     return build

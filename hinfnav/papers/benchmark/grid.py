@@ -139,7 +139,7 @@ def non_fitting(key, settings=None):
     sc = build_scenario(key, **(settings or {}))
     out = {}
     for name in registered_estimators():
-        why = fit_reason(name, sc)
+        why = fit_reason(sc, name)
         if why is not None:
             out[name] = why
     return out
@@ -163,7 +163,7 @@ def fit_matrix(papers=None):
     scenarios = {key: build_scenario(key) for key in registered_scenarios()}
     out = {}
     for name in registered_estimators():
-        why = {key: fit_reason(name, sc) for key, sc in scenarios.items()}
+        why = {key: fit_reason(sc, name) for key, sc in scenarios.items()}
         out[name] = {"description": estimator_entry(name).description, "fits": {k: w is None for k, w in why.items()},
                      "why_not": {k: w for k, w in why.items() if w is not None}}
     return {"scenarios": list(scenarios), "estimators": out}

@@ -141,7 +141,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     atomic_write_text(out / "table.csv", table.drop(columns="conditions").to_csv(index=False), newline="")
     atomic_write_text(out / "table.md", _markdown(table, best, note))
     for key in dict.fromkeys(table["scenario"]):
-        rep.save_figure(plot_scenario_heatmap(table, key), f"heatmap_{key}")
+        rep.save_figure(plot_scenario_heatmap(key, table), f"heatmap_{key}")
     elapsed = rep.elapsed_s
     summary = {
         "title": "Cross-paper benchmark: every fitting estimator on every registered scenario (issue 18)",

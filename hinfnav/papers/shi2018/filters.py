@@ -135,7 +135,7 @@ def build_hbf(scenario, *, gamma=GAMMA, tol=1e-10, max_iter=50, base=None, **opt
         return HBF(scenario, gamma=gamma, tol=tol, max_iter=max_iter, **options)
     base = _base_name(scenario) if base is None else base
     if base is not None:
-        ekf = build_estimator(base, scenario, **options)
+        ekf = build_estimator(scenario, base, **options)
         return HuberFilter.from_ekf(ekf, gamma=gamma, tol=tol, max_iter=max_iter, name="hbf")
     if not _fits_hbf(scenario):
         raise InputError(f"hbf needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}) or with "
@@ -182,7 +182,7 @@ def _kalman_base(scenario, base, options, what):
     if base is None:
         raise InputError(f"{what} needs a scenario with a registered Kalman filter ({', '.join(HBF_BASES)}); "
                          f"{type(scenario).__name__} has none")
-    return build_estimator(base, scenario, **options)
+    return build_estimator(scenario, base, **options)
 
 
 def build_stekf(scenario, *, rho=0.95, beta=1.0, a=None, base=None, **options):

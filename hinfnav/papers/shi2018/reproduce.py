@@ -214,14 +214,14 @@ def study(scenario=None, *, runs=100, seed=0, sweep_runs=None, progress=False, w
     man = _pair(maneuver)
     man["windows"] = {k: {"window_s": list(w), **_pair_window(maneuver, k)} for k, w in maneuver_windows(sc).items()
                       if k in maneuver.filters["hbf"].windows}
-    man["reaction"] = maneuver_reaction(maneuver, sc)
+    man["reaction"] = maneuver_reaction(sc, maneuver)
     man["jitter_hbf_minus_ekf"] = paired_gap(maneuver.filters["hbf"], maneuver.filters["ekf"], "jitter")
     man["dv_mps"] = float(sc.maneuver_dv()[3])
     quiet = _quiet(sc)
     man["quiet_sensors"] = {
         "note": f"every sensor error x{QUIET_FACTOR:g} (the maneuver {1 / QUIET_FACTOR:g} times larger against the "
                 f"noise), {sweep_runs} runs",
-        "reaction": maneuver_reaction(maneuver_quiet, quiet),
+        "reaction": maneuver_reaction(quiet, maneuver_quiet),
         "reaction_hbf_minus_ekf": paired_gap(maneuver_quiet.filters["hbf"], maneuver_quiet.filters["ekf"], "reaction"),
         "final_hbf_minus_ekf": paired_gap(maneuver_quiet.filters["hbf"], maneuver_quiet.filters["ekf"], "final"),
     }
@@ -311,7 +311,7 @@ def reproduce(out_dir="results/shi2018", *, seed=0, runs=100, notebooks=False, p
     figs = {"fig3": fig3(res["gaussian"], summary), "fig4": fig4(res["gaussian"], summary),
             "fig5": fig5(res["maneuver"], summary, sc.maneuver_time_s),
             "fig6": fig6(res["maneuver"], summary, sc.maneuver_time_s),
-            "maneuver_reaction": maneuver_figure(res["maneuver"], sc),
+            "maneuver_reaction": maneuver_figure(sc, res["maneuver"]),
             "sweeps": sweeps_figure(res["sensitivity"], res["mistuning"])}
     figs["mixture_position"], figs["mixture_velocity"] = mixture_figures(res["mixture"], summary)
     rep.save_figures(figs)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_int_at_least
 from ...metrics.errors import window_mask
@@ -292,7 +293,8 @@ def paired_gap(a, b, values="per_run"):
             "pos_ratio": float(pa.mean() / pb.mean()), "vel_ratio": float(va.mean() / vb.mean())}
 
 
-def maneuver_reaction(result, scenario, dv=None):
+@scenario_moved("result", "scenario", "dv", was=CaseResult)
+def maneuver_reaction(scenario, result, dv=None):
     """How each filter follows the unmodelled maneuver, from its bias (mean error over runs).
 
     Parameters

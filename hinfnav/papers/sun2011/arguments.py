@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ...core.deprecation import accepts_old_order
+from ...core.deprecation import accepts_old_order, scenario_keyword
 from .scenario import Scenario
 
 __all__ = ["scenario_first", "scenario_keyword"]
@@ -27,9 +27,3 @@ def _leads(args, kwargs):
 def scenario_first(*old_order: str, **fill: Any) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Decorator of a function whose scenario moved to the front from its place in ``old_order``."""
     return accepts_old_order(old_order, _leads, fill=fill)
-
-
-def scenario_keyword(*old_order: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Decorator of a function whose optional scenario, last in ``old_order``, became keyword-only."""
-    n = old_order.index("scenario")
-    return accepts_old_order(old_order, lambda args, kwargs: len(args) <= n)

@@ -74,7 +74,7 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
     else:
         if verbatim:
             raise InputError("verbatim applies to --design only (the registered names say how each filter runs)")
-        est = make_estimator(scenario, filter) if filter in FILTER_NAMES else build_estimator(filter, scenario)
+        est = make_estimator(scenario, filter) if filter in FILTER_NAMES else build_estimator(scenario, filter)
         label = filter
     win = scenario.rms_window_s
     stats = monte_carlo_statistics(scenario, est, windows={"main": win}, runs=runs, seed=seed, noise=noise,

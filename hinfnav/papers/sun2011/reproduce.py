@@ -29,7 +29,7 @@ NOTEBOOKS = (
 )
 
 
-def _summary(tab, designed, observer, fig7_res, scenario):
+def _summary(scenario, tab, designed, observer, fig7_res):
     t1 = {}
     for case in CASES:
         t1[case] = {}
@@ -96,7 +96,7 @@ def reproduce(out_dir="results", *, seed=0, runs=100, notebooks=False, progress=
     figs = {"fig2": fig2(runs_), "fig3": fig3(runs_), "fig4": fig4(runs_), "fig5": fig5(runs_), "fig6": fig6(runs_),
             "fig7": fig7(f7)}
     rep.save_figures(figs)
-    summary = rep.write_summary(_summary(tab, designed, observer, f7, scenario))
+    summary = rep.write_summary(_summary(scenario, tab, designed, observer, f7))
     if notebooks:
         rep.run_notebooks()
     if progress:

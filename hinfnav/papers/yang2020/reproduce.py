@@ -199,7 +199,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
                             passive=True, passive_steps=open_loop_steps + 1, progress=progress)
     timings["open_loop_s"] = time.perf_counter() - t0
     est_open = estimation_errors(open_)
-    theta_open = theta_readings_study(open_, sc)
+    theta_open = theta_readings_study(sc, open_)
     rep.save_figure(fig5(open_), "fig5")
     sat_open = saturation_summary(open_)
     del open_
