@@ -158,6 +158,19 @@ def _minimise(M, yv, x, gamma, tol, max_iter):
 
 
 @njit(cache=True, error_model="numpy")
+def _minus_outer(P, X, Y, out):
+    """out = P − X Yᵀ (summed in the order of the NumPy reference), then symmetrised: the Huber posterior."""
+    n, m = X.shape
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(m):
+                s += X[i, k] * Y[j, k]
+            out[i, j] = P[i, j] - s
+    sym(out)
+
+
+@njit(cache=True, error_model="numpy")
 def _huber_general(P, A, e, dx, gamma, tol, max_iter):
     """The whole whitened regression ``M = [A; L_P⁻¹]``, ``y = [e; 0]`` minimised from dx: ``(dx, P⁺, ok)``."""
     m, n = A.shape
@@ -246,14 +259,7 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
     for i in range(n):
         for j in range(m):
             U[i, j] = PAT[i, j] * E[j]
-    UT = mm(U, Ti)
-    for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for k in range(m):
-                s += UT[i, k] * U[j, k]
-            Pp[i, j] = P[i, j] - s
-    sym(Pp)
+    _minus_outer(P, mm(U, Ti), U, Pp)
     mv_to(PAT, cand, dx)
     return True
 
@@ -310,11 +316,5 @@ def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, 
         dx[:] = dx2
         return ok
     mm_to(PAT, Si, KW)
-    for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for k in range(m):
-                s += KW[i, k] * PAT[j, k]
-            Pp[i, j] = P[i, j] - s
-    sym(Pp)
+    _minus_outer(P, KW, PAT, Pp)
     return True
