@@ -62,7 +62,7 @@ KERNEL_CLASSES = {
 _KERNELS = {}
 
 
-def _freeze_tol(est):
+def _kernel_steady_tol(est):
     """The recursive H∞ filter's freeze tolerance for the kernel: ``steady_tol`` (rule F2 of
     :func:`~hinfnav.estimators.steady.freeze_gain`), or −1 (never: a norm is never below a negative bound)."""
     return -1.0 if est.steady_tol is None else float(est.steady_tol)
@@ -218,7 +218,7 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
                                     est.rule == "unscented", keep, xhat, Pdiag, Pfull)
     else:
         ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est._G), _float(est._HtRi), P_start, x0, y, u,
-                                       use_input, _freeze_tol(est), keep, xhat, Pdiag, Pfull)
+                                       use_input, _kernel_steady_tol(est), keep, xhat, Pdiag, Pfull)
     if not ok:
         return None, None
     P_hist = {0: None, 1: Pdiag, 2: Pfull}[keep]
