@@ -158,6 +158,17 @@ def _minimise(M, yv, x, gamma, tol, max_iter):
 
 
 @njit(cache=True, error_model="numpy")
+def _inv_eye_plus_scaled(C, E):
+    """T⁻¹ for T = I + diag(E) C diag(E), and whether T was positive definite (Cholesky)."""
+    m = E.shape[0]
+    T = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
+    return spd_inv(T)
+
+
+@njit(cache=True, error_model="numpy")
 def _minus_outer(P, X, Y, out):
     """out = P − X Yᵀ (summed in the order of the NumPy reference), then symmetrised: the Huber posterior."""
     n, m = X.shape
@@ -209,11 +220,7 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
         q = abs(zm[i]) <= gamma
         grad[i] = c[i] + (zm[i] if q else gamma * np.sign(zm[i]))
         E[i] = 1.0 if q else 0.0
-    T = np.empty((m, m))
-    for i in range(m):
-        for j in range(m):
-            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
-    Ti, ok = spd_inv(T)
+    Ti, ok = _inv_eye_plus_scaled(C, E)
     if not ok:
         return False
     Cg = mv(C, grad)
@@ -247,12 +254,7 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
     psi = _psi(zc, gamma)
     for i in range(m):
         E[i] = np.sqrt(psi[i])
-        for j in range(m):
-            T[i, j] = 0.0
-    for i in range(m):
-        for j in range(m):
-            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
-    Ti, ok = spd_inv(T)
+    Ti, ok = _inv_eye_plus_scaled(C, E)
     if not ok:
         return False
     U = np.empty((n, m))
