@@ -165,5 +165,6 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     if notebooks:
         rep.run_notebooks()
     if progress:
-        print(f"\nbenchmark: {len(table)} rows on {len(keys)} scenarios, {elapsed:.0f} s; table in {out / 'table.md'}")
+        print(f"\nbenchmark: {len(table)} rows on {len(keys)} scenarios, {elapsed:.0f} s; the table is table.md of the output "
+              "folder")
     return summary
