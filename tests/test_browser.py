@@ -125,7 +125,9 @@ def _open_and_run_all(driver, lab, name):
     from selenium.webdriver.common.keys import Keys
 
     base, token = lab
-    driver.get(f"{base}/lab/tree/{name}?token={token}")
+    # ?reset: a fresh workspace, so that the notebook of an earlier test is not restored beside this one (its
+    # panel, not yet hidden, was taken for this one's and "Run All Cells" went to it)
+    driver.get(f"{base}/lab/tree/{name}?reset&token={token}")
     _wait(lambda: driver.find_elements(By.CSS_SELECTOR, ".jp-NotebookPanel .jp-Cell"), 120, f"{name} to open")
     panel = ".jp-NotebookPanel:not(.lm-mod-hidden) "
     idle = '.jp-Notebook-ExecutionIndicator[data-status="idle"]'  # the status bar's, of the notebook in front
