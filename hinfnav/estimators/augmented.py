@@ -53,9 +53,6 @@ if TYPE_CHECKING:
 __all__ = ["AugmentedEKF", "AugmentedInputAdaptiveKF", "AugmentedInputHuberSTKF", "AugmentedInputKF",
            "AugmentedInputSTKF"]
 
-#: Keys of ``FilterState.extra`` that live from one ``predict`` to the next ``update`` only.
-_TRANSIENT = ("prior", "PhiPPhiT", "Qd", "q_used", "kappa_used")
-
 
 class AugmentedEKF(KalmanCore):
     """EKF in error coordinates with augmented random-walk states (E1)–(E2); see the module docstring.
@@ -90,7 +87,6 @@ class AugmentedEKF(KalmanCore):
     linear_model = False
     defers_prior = True
     refuse_nonfinite = True
-    transient_keys = _TRANSIENT
 
     def __init__(self, system: Any, measurement: MeasurementModel, *, n_cov: int, aug_input: int, P0: ArrayLike,
                  Q: ArrayLike, base_noise: ArrayLike | None = None, R: ArrayLike | None = None, uses_input: bool = False,
@@ -184,7 +180,7 @@ class AugmentedEKF(KalmanCore):
         Phi = self.transition(state.x, u)
         x = self.propagate_mean(state.x, u)
         PhiPPhiT = congruence(Phi, state.P)
-        extra = {k: v for k, v in state.extra.items() if k not in _TRANSIENT}
+        extra = {k: v for k, v in state.extra.items() if k not in self.transient_keys}
         extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
         return FilterState(x=x, P=PhiPPhiT + Qd, k=state.k + 1, extra=extra)
 

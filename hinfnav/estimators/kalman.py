@@ -374,7 +374,7 @@ class RateAdaptiveEKF(RateAdaptive, ExtendedKalmanFilter):
     """Rate-adapted process noise on :class:`ExtendedKalmanFilter` (R1)–(R2).
 
     On a linear system or any dynamics model; parameters of
-    :class:`ExtendedKalmanFilter` and ``states``, ``window``, ``epsilon``,
+    :class:`ExtendedKalmanFilter` and ``states``, ``memory_steps``, ``epsilon``,
     ``floor`` of :class:`~hinfnav.estimators.adaptive.RateAdaptive` (the
     diagonal entries of Q at ``states`` follow their states' estimated rate).
     Diagnostics ``q_adapted`` and ``input_rate`` (runs, len(states)).
