@@ -54,22 +54,19 @@ def system_argument(func: str, system: Any, matrices: tuple, legacy: dict[str, A
         An unknown keyword, or too many positional arguments (as Python
         reports a wrong call).
     """
+    if isinstance(system, UncertainSystem) and matrices:
+        raise InputError(f"{func}: give the UncertainSystem alone; {len(matrices)} more positional "
+                         "argument(s) were given (the loose matrices go into the UncertainSystem)")
+    unknown = sorted(set(legacy) - {"H", "E", "dt"})
+    if unknown:
+        raise TypeError(f"{func}() got an unexpected keyword argument {unknown[0]!r}")
     if isinstance(system, UncertainSystem):
-        if matrices:
-            raise InputError(f"{func}: give the UncertainSystem alone; {len(matrices)} more positional "
-                             "argument(s) were given (the loose matrices go into the UncertainSystem)")
-        unknown = sorted(set(legacy) - {"H", "E", "dt"})
-        if unknown:
-            raise TypeError(f"{func}() got an unexpected keyword argument {unknown[0]!r}")
         if legacy:
             what = ", ".join(sorted(legacy))
             hint = (" (the sampling time is the system's: dataclasses.replace(system, dt=...))" if "dt" in legacy
                     else " (the uncertainty is the system's H and E)" if {"H", "E"} & set(legacy) else "")
             raise InputError(f"{func}: unexpected keyword argument(s) {what} with an UncertainSystem{hint}")
         return system, system.dt
-    unknown = sorted(set(legacy) - {"H", "E", "dt"})
-    if unknown:
-        raise TypeError(f"{func}() got an unexpected keyword argument {unknown[0]!r}")
     if len(matrices) > 6:
         raise TypeError(f"{func}() takes an UncertainSystem (or, deprecated, at most 7 matrices A … E); "
                         f"got {1 + len(matrices)} positional arguments")
