@@ -203,23 +203,10 @@ def sym(A):
 
 @njit(cache=True, error_model="numpy")
 def chol(A):
-    """Lower Cholesky factor of a symmetric matrix; ``(L, ok)``."""
-    n = A.shape[0]
-    L = np.zeros((n, n))
-    for j in range(n):
-        s = A[j, j]
-        for k in range(j):
-            s -= L[j, k] * L[j, k]
-        if not s > 0.0:
-            return L, False
-        d = np.sqrt(s)
-        L[j, j] = d
-        for i in range(j + 1, n):
-            t = A[i, j]
-            for k in range(j):
-                t -= L[i, k] * L[j, k]
-            L[i, j] = t / d
-    return L, True
+    """Lower Cholesky factor of a symmetric matrix; ``(L, ok)`` (:func:`chol_to` into a new array)."""
+    L = np.zeros(A.shape)
+    ok = chol_to(A, L)
+    return L, ok
 
 
 @njit(cache=True, error_model="numpy")
@@ -257,11 +244,10 @@ def tri_inv(L):
 
 @njit(cache=True, error_model="numpy")
 def spd_inv(A):
-    L, ok = chol(A)
-    if not ok:
+    """``(A⁻¹, True)`` of a symmetric positive definite A (:func:`inv_to` into new arrays), else ``(A, False)``."""
+    X = np.empty(A.shape)
+    if not inv_to(A, np.zeros(A.shape), X):
         return A, False
-    X = chol_solve(L, np.eye(A.shape[0]))
-    sym(X)
     return X, True
 
 
