@@ -10,7 +10,8 @@ from ...campaign.registry import build_scenario, scenario_parameters
 from ...campaign.runner import campaign_client, run_campaign
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
-from ..skeleton import Reproduction, atomic_write_text
+from ...io.outputs import atomic_write_text
+from ..skeleton import Reproduction
 from .cross import WINDOW, cross_table, plot_scenario_heatmap, winners
 from .grid import SCENARIOS, load_papers, non_fitting, scenario_campaign
 from .limits import cell_bound

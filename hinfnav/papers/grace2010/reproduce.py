@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ...core.validation import as_int_at_least, as_seed
-from ..skeleton import Reproduction, atomic_write_text
+from ...io.outputs import atomic_write_text
+from ..skeleton import Reproduction
 from .constants import CITATION, DT_S, KBAND_TOLERANCE_M, TRUTH_SIGMA_M
 from .dataset import load
 from .figures import errors_figure, mismatch_figure, truth_figure
