@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING
 from ..core.lazy import lazy_exports
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
-    from .outputs import MARKER, atomic_output_dir, check_output_dir, lock_path, output_lock, to_json, write_json
+    from .outputs import (MARKER, atomic_output_dir, atomic_write_text, check_output_dir, lock_path, output_lock, to_json,
+                          write_json)
     from .progress import bar_disabled
     from .provenance import LIBRARIES, git_commit, package_version, provenance
 
@@ -27,6 +28,7 @@ __all__ = [
     "lock_path",
     "output_lock",
     "to_json",
+    "atomic_write_text",
     "write_json",
     "bar_disabled",
     "LIBRARIES",

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..core.exceptions import InputError
 
-__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "write_json"]
+__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
+           "write_json"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
 MARKER = ".hinfnav-output"
@@ -149,8 +150,21 @@ def to_json(obj: Any, *, strict: bool = False) -> Any:
     return obj
 
 
-def write_json(path: str | os.PathLike, obj: Any) -> Any:
-    """Write ``to_json(obj)`` to ``path`` (indented, newline at the end); return the written object."""
-    data = to_json(obj)
-    Path(path).write_text(json.dumps(data, indent=2) + "\n")
+def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8", newline: str | None = None) -> Path:
+    """Write ``text`` to ``path`` through a temporary file beside it and :func:`os.replace` (never half a file).
+
+    ``newline=""`` writes the line ends as they are in ``text`` (what :mod:`csv` needs); the default
+    translates ``"\\n"`` to the platform's line end, like :meth:`pathlib.Path.write_text`.
+    """
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text, encoding=encoding, newline=newline)
+    os.replace(tmp, path)
+    return path
+
+
+def write_json(path: str | os.PathLike, obj: Any, *, strict: bool = False) -> Any:
+    """Write ``to_json(obj, strict=strict)`` to ``path`` atomically (indented, newline at the end); return it."""
+    data = to_json(obj, strict=strict)
+    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
     return data

@@ -11,8 +11,7 @@ import json
 from pathlib import Path
 
 from ..core.exceptions import InputError
-from ..io.outputs import to_json
-from .skeleton import atomic_write_text
+from ..io.outputs import atomic_write_text, to_json
 
 __all__ = ["CLAIM_COLUMNS", "claims_rows", "format_claims_table", "write_claims_table"]
 
@@ -62,6 +61,6 @@ def write_claims_table(claims, out_dir, title, name="claims"):
     for r in claims_rows(claims):
         writer.writerow({k: _cell(v) for k, v in r.items()})
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
-    atomic_write_text(csv_path, buf.getvalue())
+    atomic_write_text(csv_path, buf.getvalue(), newline="")
     atomic_write_text(md_path, format_claims_table(claims, title))
     return csv_path, md_path

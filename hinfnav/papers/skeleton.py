@@ -15,8 +15,6 @@ output folder and writes through it, so that every paper
   (:func:`hinfnav.io.progress.bar_disabled`); with ``progress=False``, silence.
 """
 
-import json
-import os
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -24,26 +22,13 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ..core.exceptions import InputError
-from ..io.outputs import to_json
+from ..io.outputs import atomic_write_text, write_json
 from ..io.progress import bar_disabled
 from ..io.provenance import provenance
 from ..plotting.save import save_figure
 from .notebooks import check_notebooks, run_notebooks
 
-__all__ = ["Reproduction", "atomic_write_text"]
-
-
-def atomic_write_text(path, text, encoding="utf-8", newline=None):
-    """Write ``text`` to ``path`` through a temporary file beside it and :func:`os.replace` (never half a file).
-
-    ``newline=""`` writes the line ends as they are in ``text`` (what :mod:`csv` needs); the default
-    translates ``"\\n"`` to the platform's line end, like :meth:`pathlib.Path.write_text`.
-    """
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding=encoding, newline=newline)
-    os.replace(tmp, path)
-    return path
+__all__ = ["Reproduction", "atomic_write_text"]  # atomic_write_text: re-exported from hinfnav.io.outputs
 
 
 class Reproduction:
@@ -144,8 +129,8 @@ class Reproduction:
         """
         if not isinstance(summary, Mapping):
             raise InputError(f"summary must be a dict; got {type(summary).__name__}")
-        data = to_json({**summary, "provenance": self.provenance}, strict=strict)
-        path = atomic_write_text(self.out / name, json.dumps(data, indent=2) + "\n")
+        path = self.out / name
+        data = write_json(path, {**summary, "provenance": self.provenance}, strict=strict)
         self.written.append(path)
         return data
 

@@ -6,8 +6,8 @@ over runs, samples and the group's components in the ``steady`` window, its
 95 % interval (the campaign's, :func:`hinfnav.campaign.stats.rms_interval`),
 the bound, the ratio RMS/bound with the interval divided by the same bound,
 and the cell's NEES and NIS (:mod:`hinfnav.metrics.consistency`).
-:func:`winners` says which estimator wins where; :func:`plot_scenario_heatmap`
-draws one scenario's ratios.
+:func:`winners` says which estimator wins where, :func:`format_cross_markdown`
+writes both as Markdown; :func:`plot_scenario_heatmap` draws one scenario's ratios.
 """
 
 import numpy as np
@@ -17,7 +17,7 @@ from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure
 
-__all__ = ["cross_table", "winners", "plot_scenario_heatmap", "condition_label", "WINDOW"]
+__all__ = ["cross_table", "winners", "format_cross_markdown", "plot_scenario_heatmap", "condition_label", "WINDOW"]
 
 #: The table's window (every scenario of :data:`~.grid.SCENARIOS` has one of this name).
 WINDOW = "steady"
@@ -130,3 +130,30 @@ def plot_scenario_heatmap(scenario, table, *, axes=None):
         ax.set_title(f"{scenario}: {q} RMS / {'Riccati limit' if kind == 'riccati' else 'posterior CRB'}", fontsize=9)
         ax.figure.colorbar(img, ax=ax, label="log₁₀ ratio (–)")
     return axes[0].figure
+
+
+def format_cross_markdown(table, best, note):
+    """``table.md`` of the benchmark: per scenario and quantity, estimators × conditions, ratio [95 % interval];
+    then :func:`winners`' ``best`` (which estimator wins where). ``note`` goes under the title."""
+    lines = ["# Cross-paper benchmark", "", note, "",
+             "Each entry: RMS error (pooled over runs, samples of the steady window and the group's components) "
+             "divided by the cell's bound — the Riccati limit of a linear-Gaussian cell, the posterior Cramér–Rao "
+             "bound of the others — with its 95 % interval. 1: at the bound. NEES, NIS and absolute errors are in "
+             "`table.csv` and `summary.json`.", ""]
+    for sc, sub in table.groupby("scenario", sort=False):
+        for q, part in sub.groupby("quantity", sort=False):
+            conds = list(dict.fromkeys(part["condition"]))
+            lines += [f"## {sc}: {q} ({part['unit'].iloc[0]}), bound: {part['bound_kind'].iloc[0]}", "",
+                      "| estimator | " + " | ".join(conds) + " |", "|---|" + "---|" * len(conds)]
+            for est, rows in part.groupby("estimator", sort=False):
+                by = {r.condition: r for r in rows.itertuples()}
+                cells = [f"{by[c].ratio:.3g} [{by[c].ratio_low:.3g}, {by[c].ratio_high:.3g}]" if c in by else "—"
+                         for c in conds]
+                lines.append(f"| `{est}` | " + " | ".join(cells) + " |")
+            lines.append("")
+    lines += ["## Which estimator wins where", "", "| scenario | condition | quantity | best (ratio) | runner-up (ratio) "
+              "| intervals separate |", "|---|---|---|---|---|---|"]
+    for b in best:
+        lines.append(f"| {b['scenario']} | {b['condition']} | {b['quantity']} | `{b['best']}` ({b['ratio']:.3g}) | "
+                     f"`{b['runner_up']}` ({b['runner_up_ratio']:.3g}) | {b['separated']} |")
+    return "\n".join(lines) + "\n"

@@ -10,8 +10,9 @@ from ...campaign.registry import build_scenario, scenario_parameters
 from ...campaign.runner import campaign_client, run_campaign
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
-from ..skeleton import Reproduction, atomic_write_text
-from .cross import WINDOW, cross_table, plot_scenario_heatmap, winners
+from ...io.outputs import atomic_write_text
+from ..skeleton import Reproduction
+from .cross import WINDOW, cross_table, format_cross_markdown, plot_scenario_heatmap, winners
 from .grid import SCENARIOS, load_papers, non_fitting, scenario_campaign
 from .limits import cell_bound
 
@@ -25,31 +26,6 @@ NOTEBOOKS = ("90_cross_paper_benchmark.ipynb",)
 BENCHMARK_RUNS = 50
 #: Truth runs of the Monte Carlo mean in a posterior CRB (independent of the cells' draws).
 BOUND_RUNS = 20
-
-
-def _markdown(table, best, note):
-    lines = ["# Cross-paper benchmark", "", note, "",
-             "Each entry: RMS error (pooled over runs, samples of the steady window and the group's components) "
-             "divided by the cell's bound — the Riccati limit of a linear-Gaussian cell, the posterior Cramér–Rao "
-             "bound of the others — with its 95 % interval. 1: at the bound. NEES, NIS and absolute errors are in "
-             "`table.csv` and `summary.json`.", ""]
-    for sc, sub in table.groupby("scenario", sort=False):
-        for q, part in sub.groupby("quantity", sort=False):
-            conds = list(dict.fromkeys(part["condition"]))
-            lines += [f"## {sc}: {q} ({part['unit'].iloc[0]}), bound: {part['bound_kind'].iloc[0]}", "",
-                      "| estimator | " + " | ".join(conds) + " |", "|---|" + "---|" * len(conds)]
-            for est, rows in part.groupby("estimator", sort=False):
-                by = {r.condition: r for r in rows.itertuples()}
-                cells = [f"{by[c].ratio:.3g} [{by[c].ratio_low:.3g}, {by[c].ratio_high:.3g}]" if c in by else "—"
-                         for c in conds]
-                lines.append(f"| `{est}` | " + " | ".join(cells) + " |")
-            lines.append("")
-    lines += ["## Which estimator wins where", "", "| scenario | condition | quantity | best (ratio) | runner-up (ratio) "
-              "| intervals separate |", "|---|---|---|---|---|---|"]
-    for b in best:
-        lines.append(f"| {b['scenario']} | {b['condition']} | {b['quantity']} | `{b['best']}` ({b['ratio']:.3g}) | "
-                     f"`{b['runner_up']}` ({b['runner_up_ratio']:.3g}) | {b['separated']} |")
-    return "\n".join(lines) + "\n"
 
 
 def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, notebooks=False, progress=True,
@@ -139,7 +115,7 @@ def reproduce(out_dir="results/benchmark", *, seed=0, runs=BENCHMARK_RUNS, noteb
     note = (f"{runs} Monte Carlo runs per cell (seeds from the cell, common to every estimator of a grid point); "
             f"ratios over the `{WINDOW}` window of each scenario.")
     atomic_write_text(out / "table.csv", table.drop(columns="conditions").to_csv(index=False), newline="")
-    atomic_write_text(out / "table.md", _markdown(table, best, note))
+    atomic_write_text(out / "table.md", format_cross_markdown(table, best, note))
     for key in dict.fromkeys(table["scenario"]):
         rep.save_figure(plot_scenario_heatmap(key, table), f"heatmap_{key}")
     elapsed = rep.elapsed_s

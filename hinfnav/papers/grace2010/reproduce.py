@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ...core.validation import as_int_at_least, as_seed
-from ..skeleton import Reproduction, atomic_write_text
+from ...io.outputs import atomic_write_text
+from ..skeleton import Reproduction
 from .constants import CITATION, DT_S, KBAND_TOLERANCE_M, TRUTH_SIGMA_M
 from .dataset import load
 from .figures import errors_figure, mismatch_figure, truth_figure
@@ -75,10 +76,10 @@ def run_study(data, *, variants=VARIANTS, seed=0, filters=FILTER_NAMES, design_d
     sets = {variant: make_measurements(data, variant, seed=seed) for variant in variants}
     table = {v: {"notes": ms.notes, "filters": {}} for v, ms in sets.items()}
     errors = {v: {} for v in sets}
+    lin = {v: linear_form(ms) for v, ms in sets.items()}  # (positions, linear model) of each variant, converted once
     for group in shared_model_groups(sets):
         # the variants of one linear measurement model (the GNSS ones) share their filters: one batched pass each
-        ms0 = sets[group[0]]
-        built = build_filters(data, ms0.model, linear_form(ms0)[1], Q_hill, Q_j2, use)
+        built = build_filters(data, sets[group[0]].model, lin[group[0]][1], Q_hill, Q_j2, use)
         for name in filters:
             if name not in built:
                 for variant in group:
@@ -86,7 +87,7 @@ def run_study(data, *, variants=VARIANTS, seed=0, filters=FILTER_NAMES, design_d
                         "error": "not run: no design (designs=False, or the design failed: see designs)"}
                 continue
             est, form = built[name]
-            ys = np.stack([(sets[v].y if form == "direct" else linear_form(sets[v])[0])[:n] for v in group])
+            ys = np.stack([(sets[v].y if form == "direct" else lin[v][0])[:n] for v in group])
             xh, P = run_filter(est, ys, np.stack([sets[v].available[:n] for v in group]), x0)
             for i, variant in enumerate(group):
                 row = error_metrics(xh[i], None if P is None else P[i], truth, t, data.period_s)

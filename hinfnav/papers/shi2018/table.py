@@ -11,8 +11,8 @@ import io
 from pathlib import Path
 
 from ...core.exceptions import InputError
+from ...io.outputs import atomic_write_text
 from ...metrics.intervals import format_interval
-from ..skeleton import atomic_write_text
 
 __all__ = ["TABLE_FILTERS", "table_rows", "format_table", "write_table"]
 

@@ -27,6 +27,7 @@ from tqdm import tqdm
 
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_seed
+from ...io.outputs import atomic_write_text
 from ...io.progress import bar_disabled
 from ...design.result import SynthesisResult
 from ...metrics.errors import axes_rms, rms_per_run
@@ -37,7 +38,6 @@ from .designs import design_for_scenario
 from .filters import lti_from_matrices, make_estimator
 from .limits import kalman_limit
 from .scenario import Scenario
-from ..skeleton import atomic_write_text
 
 __all__ = ["TABLE_FILTERS", "filter_labels", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows",
            "format_table1", "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
