@@ -38,7 +38,7 @@ from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.sim import simulate_truth
 
 SUN = Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0))
-SHI = ShiScenario(duration_s=40.0, window_s=(4.0, 40.0), maneuver_time_s=20.0)
+SHI = ShiScenario(duration_s=40.0, rms_window_s=(4.0, 40.0), maneuver_time_s=20.0)
 ATTITUDE = AttitudeScenario(orbits=0.05)
 YANG = YangScenario(n_steps=300)
 NAMES = registered_estimators()

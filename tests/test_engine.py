@@ -123,8 +123,7 @@ class _Recording(HistorySink):
 
 
 def test_a_failing_estimator_stops_alone_when_the_sink_records_it():
-    from hinfnav import make_estimator
-    failing = _Failing(make_estimator("ekf", SUN))
+    failing = _Failing(sun2011.make_estimator(SUN, "ekf"))
     sink = _Recording(SUN.xhat0, 6)
     out = run_monte_carlo(SUN, {"failing": failing, "published": "published"}, sink=sink, runs=6, seed=2,
                           batch_size=2, keep_covariance=False, maneuver=True)

@@ -208,7 +208,7 @@ def _four_scenarios():
     from hinfnav.papers import attitude2018, shi2018, sun2011, yang2020
     return {
         "sun2011": (sun2011.Scenario(duration_s=20.0, rms_window_s=(0.0, 20.0)), "published", {}),
-        "shi2018": (shi2018.Scenario(duration_s=600.0, window_s=(200.0, 600.0)), "ukf", {"maneuver": True}),
+        "shi2018": (shi2018.Scenario(duration_s=600.0, rms_window_s=(200.0, 600.0)), "ukf", {"maneuver": True}),
         "attitude2018": (attitude2018.Scenario().short(0.02), "aekf", {}),
         "yang2020": (yang2020.Scenario(n_steps=200), "yang2020_fused", {}),
     }
