@@ -185,6 +185,26 @@ class DynamicsModel:
         out = self.f(x, u, t)
         return out if w is None else out + np.asarray(w, dtype=float)
 
+    @property
+    def n_noise(self) -> int:
+        """Number of unit process-noise channels a simulated truth draws (:meth:`step`): n."""
+        return self.n
+
+    @property
+    def noise_gain(self) -> NDArray[np.float64]:
+        """G (n, n) with G Gᵀ = Q: the symmetric square root of Q (its eigenvalues clipped at 0, Q being semidefinite)."""
+        lam, V = np.linalg.eigh(self.Q)
+        return (V * np.sqrt(np.clip(lam, 0.0, None))) @ V.T
+
+    def step(self, x: ArrayLike, u: ArrayLike | None = None, w: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
+        """One step of a simulated truth from a unit-variance draw w (runs, n): ``f(x, u, t) + G w``, G Gᵀ = Q.
+
+        This is what :func:`hinfnav.sim.simulate_truth` and the Monte Carlo engine call for a
+        system that is not linear, so a dynamics model of your own is simulated with the noise
+        model chosen there (Gaussian, mixture, …) at the covariance Q the filters assume.
+        """
+        return self.propagate(x, u, None if w is None else np.asarray(w, dtype=float) @ self.noise_gain.T, t)
+
     def __repr__(self):
         return f"<{type(self).__name__} {self.name!r} n={self.n} dt={self.dt}>"
 
