@@ -12,7 +12,7 @@ on its rate, input unit/s, and ``input_std0``, its initial σ). On it:
 ``model_stekf``     strong tracking (:class:`~hinfnav.estimators.kalman.StrongTrackingEKF`, ρ = 0.95, β = 1)
 ``model_adaptive``  the unknown input as a random walk whose noise follows its estimated rate
                     (:class:`~hinfnav.estimators.augmented.AugmentedInputAdaptiveKF`; linear dynamics):
-                    Q = ḟ_max² T, base Q/100, ε with Q/100 (ε ḟ_max)² = Q, window 50 steps —
+                    Q = ḟ_max² T, base Q/100, ε with Q/100 (ε ḟ_max)² = Q, memory m = 50 steps —
                     the rule of :mod:`hinfnav.papers.attitude2018.chaser`, not tuned on any truth
 ==================  =====================================================================================
 
@@ -77,8 +77,8 @@ def build_generic(scenario, kind, **options):
         q = rate**2 * T
         n_u = system.n_input
         return AugmentedInputAdaptiveKF(system, meas, Q_input=q / 100 * np.eye(n_u), P0=P0,
-                                        P0_input=m["input_std0"] ** 2 * np.eye(n_u), epsilon=10.0 / rate, window=50,
-                                        name=name, **options)
+                                        P0_input=m["input_std0"] ** 2 * np.eye(n_u), epsilon=10.0 / rate,
+                                        memory_steps=50, name=name, **options)
     ekf = ExtendedKalmanFilter(system, meas, P0=P0, uses_input=m["uses_input"], name="model_ekf",
                                **(options if kind == "ekf" else {}))
     if kind == "ekf":
