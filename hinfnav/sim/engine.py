@@ -50,9 +50,10 @@ from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
-from ..estimators.base import EstimateHistory, Estimator, history_keys, store_diagnostics
+from ..estimators.base import EstimateHistory, Estimator
 from ..estimators.registry import build_estimator
 from .result import SimulationResult
+from .stepped import EstimatorStage, ModelPlant, run_stepped
 from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, scenario_truth_model, simulate_truth
 
 if TYPE_CHECKING:
@@ -253,36 +254,13 @@ def closed_loop_batch(model: TruthModel, estimator: Estimator, controller: Calla
     when its ``source`` is ``"truth"``), the plant moves (``propagate`` of a
     linear system, ``step`` of a nonlinear one) and the estimator predicts with u_k.
     """
-    system, meas = model.system, model.measurement
-    keys = history_keys(keep_covariance, diagnostics)
-    runs, n1 = w.shape[:2]
-    step = getattr(system, "step", None)
-    on_truth = getattr(controller, "source", "estimate") == "truth"
-    x = np.empty((runs, n1, system.n))
-    xhat = np.empty_like(x)
-    u = np.empty((runs, n1, system.n_input))
-    y = np.empty((runs, n1, meas.n_meas))
-    P_hist, diag = None, {}
-    x[:, 0] = model.x0
-    t = model.time
-    state = estimator.start(np.asarray(xhat0, dtype=float), P0, runs)
-    for k in range(n1):
-        y[:, k] = meas.measure(x[:, k], v[:, k])
-        state, out = estimator.update(state, y[:, k])
-        xhat[:, k] = out.xhat
-        if keep_covariance and out.P is not None:
-            P = np.diagonal(out.P, axis1=-2, axis2=-1) if keep_covariance == "diagonal" else out.P
-            if P_hist is None:
-                P_hist = np.empty((runs, n1) + P.shape[-(1 if keep_covariance == "diagonal" else 2):])
-            P_hist[:, k] = P
-        store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
-        u[:, k] = controller(x[:, k] if on_truth else xhat[:, k])
-        if k < n1 - 1:
-            x[:, k + 1] = (step(x[:, k], u[:, k], w[:, k], t[k]) if callable(step)
-                           else system.propagate(x[:, k], u[:, k], w[:, k]))
-            state = estimator.predict(state, u[:, k])
-    truth = Truth(t=t, x=x, u=u, y=y, settings=dict(model.settings), state=system.state, measurement=meas)
-    return truth, EstimateHistory(xhat=xhat, P=P_hist, state=system.state, diagnostics=diag)
+    plant = ModelPlant(model, w, v)
+    stage = EstimatorStage(estimator, np.asarray(xhat0, dtype=float), P0, keep_covariance=keep_covariance,
+                           diagnostics=diagnostics, n1=plant.n1)
+    hist = run_stepped(plant, stage, controller)
+    truth = Truth(t=plant.t, x=hist.x, u=hist.u, y=plant.y, settings=dict(model.settings), state=model.system.state,
+                  measurement=model.measurement)
+    return truth, EstimateHistory(xhat=hist.xhat, P=stage.P, state=model.system.state, diagnostics=stage.diagnostics)
 
 
 def _closed_loop_controller(model, controller):

@@ -32,12 +32,11 @@ seed gives the same numbers whatever the number of runs.
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from tqdm import tqdm
 
 from ...core.exceptions import InputError
-from ...io.progress import bar_disabled
 from ...control.adrc import DragFreeADRC
 from ...core.validation import as_choice, as_int_at_least
+from ...sim.stepped import SteppedPlant, run_stepped
 from ...sim.truth import child_rngs
 from .constants import ACCELEROMETER_RANGE, D_TRANS, K_TRANS, M_SC, M_TM
 from .filters import build_alg1, build_alg2, build_fused
@@ -180,6 +179,141 @@ class Alg2Bank:
         return self.alg.to_full(X).reshape(3, self.runs, 9)
 
 
+class _Plant(SteppedPlant):
+    """The plant (4) and its sensors (5), (11), (14) on ``nv × runs`` rows: the plant hooks of the stepped loop.
+
+    Noise: per run, blocks of :data:`BLOCK` steps, w (9) then d (9) then d_a (3), from the run's generator;
+    the rows of every variant share their run's draws, scaled by their own standard deviations ``sd``.
+    """
+
+    def __init__(self, sc, nv, runs, rngs, sd, F, same_f):
+        m = sc.model
+        self.x0, self.nv, self.rngs, self.sd, self.F, self.same_f = sc.x0, nv, rngs, sd, F, same_f
+        self.rows, self.n1, self.n_input = nv * runs, sc.n_steps + 1, 9
+        self.prior = sc.timing == "prior"
+        self.PhiT, self.GamT, self.CaT = m.Phi.T, m.Gamma.T, m.accel_C.T
+        self.lo, self.up = ACCELEROMETER_RANGE
+        self.drive = np.empty((self.rows, self.n1, 9))  # u + w + f
+        self.acc = np.empty((self.rows, self.n1, 3))  # unclipped readings
+        self.w_prev = np.zeros((self.rows, 9))  # input noise of the hold interval that ends at t_k
+
+    def start(self):
+        return np.broadcast_to(self.x0, (self.rows, 18)).copy()
+
+    def draw(self, k):
+        nb = min(BLOCK, self.n1 - k)
+        blocks = [[rng.standard_normal((nb, p)) for p in (9, 9, 3)] for rng in self.rngs]
+        self.W, self.Dn, self.Da = (np.tile(np.stack([b[i] for b in blocks]), (self.nv, 1, 1)) * sd
+                                    for i, sd in enumerate(self.sd))
+        self.k0 = k
+        return k + nb
+
+    def measure(self, k, x, u_read):
+        """Y_k (5) and the clipped a_k (11), (14) as one reading (rows, 12); a_k contains ``u_read`` and its noise."""
+        j = k - self.k0
+        fk = self.fk = self.F[k] if self.same_f else self.F[:, k]
+        wk = self.wk = self.W[:, j]
+        w_read = wk if self.prior else self.w_prev
+        Y = self.Y = x[:, MEASURED_INDICES] + self.Dn[:, j]
+        a_raw = self.a_raw = x @ self.CaT + (u_read[:, 3:6] + w_read[:, 3:6] + fk[..., 3:6]) * (1.0 / M_SC) + self.Da[:, j]
+        a_c = self.a_c = np.clip(a_raw, self.lo, self.up)
+        return np.concatenate([Y, a_c], axis=1)
+
+    def record(self, k, x, u):
+        g = self.g = u + self.wk + self.fk
+        self.drive[:, k], self.acc[:, k] = g, self.a_raw
+
+    def step(self, k, x, u):
+        self.w_prev = self.wk
+        return x @ self.PhiT + self.g @ self.GamT
+
+
+class _FusedGroups:
+    """Algorithm 3 per group of rows with equal readings (:data:`FILTER_FIELDS`): the estimator stage.
+
+    ``groups``: lists ``[rows slice, fused filter, its state, first steady step, x̂0]``, updated in place.
+    """
+
+    n_state = 27
+
+    def __init__(self, groups, rows):
+        self.groups, self.one = groups, len(groups) == 1
+        self.xhat = np.empty((rows, 27))
+
+    def start(self, rows):
+        for grp in self.groups:
+            grp[2] = grp[1].start(grp[4], None, grp[0].stop - grp[0].start)
+
+    def update(self, k, y, u_read):
+        one = self.one
+        for grp in self.groups:
+            sl, fused, fs = grp[0], grp[1], grp[2]
+            fs = fused.feed_input(fs, u_read if one else u_read[sl])
+            fs, out = fused.update(fs, y if one else y[sl])
+            grp[2] = fs
+            if one:
+                xhat = out.xhat
+            else:
+                self.xhat[sl] = out.xhat
+            if grp[3] is None and fs.extra["steady"] is not None:
+                grp[3] = k
+        return xhat if one else self.xhat
+
+    def prior(self):
+        return self.groups[0][2].x if self.one else np.concatenate([grp[2].x for grp in self.groups])
+
+    def predict(self, k, u):
+        one = self.one
+        for grp in self.groups:
+            grp[2] = grp[1].predict(grp[2], u if one else u[grp[0]])
+
+
+class _Law:
+    """The stacked ADRC laws with the attitude command (a stateful law); counts the steps each variant clipped."""
+
+    def __init__(self, law, ref, nv):
+        self.law, self.ref, self.nv = law, ref, nv
+        self.clipped = np.zeros(nv, dtype=int)
+
+    def start(self, rows):
+        return self.law.start(rows)
+
+    def step(self, k, xhat, cs):
+        u, ucmd, cs = self.law(xhat, self.ref[k], cs)
+        if self.nv == 1:
+            self.clipped[0] += bool(np.any(u != ucmd))
+        else:
+            self.clipped += np.any((u != ucmd).reshape(self.nv, -1), axis=1)
+        return u, cs
+
+
+class _Passive:
+    """Algorithm 1 and L1, L2, L3 (:class:`Alg2Bank`) on the readings of rows ``prow`` over the first ``n`` steps.
+
+    A passive observer: fed the plant's last readings, told the input the reading contains and the one the plant
+    moves with; ``h`` holds the filtered ``[r, ṙ, F_Dsc]`` (prow.size, n, 9) of each of :data:`PASSIVE`.
+    """
+
+    def __init__(self, plant, sc, prow, n):
+        self.plant, self.prow, self.n = plant, prow, n
+        self.all = prow.size == plant.rows
+        self.h = {name: np.empty((prow.size, n, 9)) for name in PASSIVE}
+        self.a1 = build_alg1(sc, steady_tol=sc.steady_tol)
+        self.s1 = self.a1.start(sc.xhat0, None, prow.size)
+        self.bank = Alg2Bank(build_alg2(sc, mode="truncated"), prow.size)
+
+    def observe(self, k, y, u_read, u):
+        if k >= self.n:
+            return
+        p, h, prow = self.plant, self.h, self.prow
+        Yp, up_, ur, ar, ac = ((p.Y, u, u_read, p.a_raw, p.a_c) if self.all else
+                               (p.Y[prow], u[prow], u_read[prow], p.a_raw[prow], p.a_c[prow]))
+        self.s1, o1 = self.a1.update(self.s1, Yp)
+        h["alg1"][:, k] = o1.xhat[:, 9:18]
+        self.s1 = self.a1.predict(self.s1, up_)
+        h["L1"][:, k], h["L2"][:, k], h["L3"][:, k] = self.bank.step(ar, ac, ur[:, 3:6], up_[:, 3:6])
+
+
 def run_closed_loop(scenario, *, controller="adrc", runs=1, seed=0, passive=True, passive_steps=100_000,
                     progress=False):
     """Simulate the closed loop of Section 3 (see the module docstring).
@@ -278,111 +412,48 @@ def run_closed_loops(variants, *, runs=1, seed=0, passive=True, passive_steps=10
         raise InputError("the standalone estimators (passive) run on the variants of the first variant's readings only")
     rngs = child_rngs(seed, runs)
     sc = pairs[0][0]
-    m = sc.model
     n1 = sc.n_steps + 1
     rows = nv * runs
     t = np.arange(n1) * sc.dt
     ref = sc.attitude_reference(n1)
-    law = DragFreeADRC.stacked([s.controller(kind) for s, kind in pairs], runs)  # one call for every row
+    law = _Law(DragFreeADRC.stacked([s.controller(kind) for s, kind in pairs], runs), ref, nv)  # one call for every row
     slices = [slice(v * runs, (v + 1) * runs) for v in range(nv)]
-    groups = []  # (rows slice, fused filter, its state, first variant)
+    groups = []  # [rows slice, fused filter, its state, first steady step, x̂0]
     for key in group_keys:
         vs = [v for v in range(nv) if keys[order[v]] == key]
         g_sc = pairs[vs[0]][0]
-        fused = build_fused(g_sc, steady_tol=g_sc.steady_tol)
-        groups.append([slice(vs[0] * runs, (vs[-1] + 1) * runs), fused, fused.start(g_sc.xhat0, None, len(vs) * runs),
-                       None])
-    one = len(groups) == 1
-    lo, up = ACCELEROMETER_RANGE
-    if one:  # per-step standard deviations of w, d, d_a
-        sd_w, sd_d, sd_a = sc.input_std, sc.sensor_std, sc.accel_std
+        groups.append([slice(vs[0] * runs, (vs[-1] + 1) * runs), build_fused(g_sc, steady_tol=g_sc.steady_tol), None,
+                       None, g_sc.xhat0])
+    if len(groups) == 1:  # per-step standard deviations of w, d, d_a
+        sd = (sc.input_std, sc.sensor_std, sc.accel_std)
     else:
-        sd_w, sd_d, sd_a = (np.repeat(np.stack([getattr(s, name) for s, _ in pairs]), runs, axis=0)[:, None]
-                            for name in ("input_std", "sensor_std", "accel_std"))
+        sd = tuple(np.repeat(np.stack([getattr(s, name) for s, _ in pairs]), runs, axis=0)[:, None]
+                   for name in ("input_std", "sensor_std", "accel_std"))
     fs_v = [disturbance(t, s.w_d) for s, _ in pairs]
     same_f = all(s.w_d == sc.w_d for s, _ in pairs)
     F = fs_v[0] if same_f else np.repeat(np.stack(fs_v), runs, axis=0)  # (n1, 9) or (rows, n1, 9)
-    PhiT, GamT, CaT = m.Phi.T, m.Gamma.T, m.accel_C.T
-
-    x_h = np.empty((rows, n1, 18))
-    u_h, g_h, xhat_h, acc_h = (np.empty((rows, n1, k)) for k in (9, 9, 27, 3))
-    xhat = np.empty((rows, 27))
-    clipped = np.zeros(nv, dtype=int)
+    plant = _Plant(sc, nv, runs, rngs, sd, F, same_f)
     n_passive = min(n1, as_int_at_least("passive_steps", passive_steps, 0)) if any(flags) else 0
-    prow = np.concatenate([np.arange(rows)[sl] for sl, fl in zip(slices, flags) if fl]) if n_passive else None
-    pas = {name: np.empty((prow.size, n_passive, 9)) for name in PASSIVE} if n_passive else {}
+    observers = ()
     if n_passive:
-        a1 = build_alg1(sc, steady_tol=sc.steady_tol)
-        s1 = a1.start(sc.xhat0, None, prow.size)
-        bank = Alg2Bank(build_alg2(sc, mode="truncated"), prow.size)
-        all_passive = prow.size == rows
-    x = np.broadcast_to(sc.x0, (rows, 18)).copy()
-    cs = law.start(rows)
-    prior = sc.timing == "prior"
-    u_prev = np.zeros((rows, 9))  # input and input noise of the hold interval that ends at t_k
-    w_prev = np.zeros((rows, 9))
-    for k in tqdm(range(n1), disable=bar_disabled(progress), desc=f"closed loop ({', '.join(p[1] for p in pairs)})",
-                  unit="step", mininterval=1.0, leave=False):
-        j = k % BLOCK
-        if j == 0:
-            nb = min(BLOCK, n1 - k)
-            blocks = [[rng.standard_normal((nb, p)) for p in (9, 9, 3)] for rng in rngs]
-            W, Dn, Da = (np.tile(np.stack([b[i] for b in blocks]), (nv, 1, 1)) * sd
-                         for i, sd in enumerate((sd_w, sd_d, sd_a)))
-        fk, wk = (F[k] if same_f else F[:, k]), W[:, j]
-        if prior:
-            x_prior = groups[0][2].x if one else np.concatenate([grp[2].x for grp in groups])
-            u, ucmd, cs = law(x_prior, ref[k], cs)
-            u_read, w_read = u, wk
-        else:
-            u_read, w_read = u_prev, w_prev
-        Y = x[:, MEASURED_INDICES] + Dn[:, j]
-        a_raw = x @ CaT + (u_read[:, 3:6] + w_read[:, 3:6] + fk[..., 3:6]) * (1.0 / M_SC) + Da[:, j]
-        a_c = np.clip(a_raw, lo, up)
-        Yall = np.concatenate([Y, a_c], axis=1)
-        for grp in groups:
-            sl, fused, fs = grp[0], grp[1], grp[2]
-            fs = fused.feed_input(fs, u_read if one else u_read[sl])
-            fs, out = fused.update(fs, Yall if one else Yall[sl])
-            grp[2] = fs
-            if one:
-                xhat = out.xhat
-            else:
-                xhat[sl] = out.xhat
-            if grp[3] is None and fs.extra["steady"] is not None:
-                grp[3] = k
-        if not prior:
-            u, ucmd, cs = law(xhat, ref[k], cs)
-        if nv == 1:
-            clipped[0] += bool(np.any(u != ucmd))
-        else:
-            clipped += np.any((u != ucmd).reshape(nv, -1), axis=1)
-        g = u + wk + fk
-        x_h[:, k], u_h[:, k], g_h[:, k], xhat_h[:, k], acc_h[:, k] = x, u, g, xhat, a_raw
-        if k < n_passive:
-            Yp, up_, ur, ar, ac = ((Y, u, u_read, a_raw, a_c) if all_passive else
-                                   (Y[prow], u[prow], u_read[prow], a_raw[prow], a_c[prow]))
-            s1, o1 = a1.update(s1, Yp)
-            pas["alg1"][:, k] = o1.xhat[:, 9:18]
-            s1 = a1.predict(s1, up_)
-            pas["L1"][:, k], pas["L2"][:, k], pas["L3"][:, k] = bank.step(ar, ac, ur[:, 3:6], up_[:, 3:6])
-        for grp in groups:
-            grp[2] = grp[1].predict(grp[2], u if one else u[grp[0]])
-        x = x @ PhiT + g @ GamT
-        u_prev, w_prev = u, wk
+        prow = np.concatenate([np.arange(rows)[sl] for sl, fl in zip(slices, flags) if fl])
+        observers = (_Passive(plant, sc, prow, n_passive),)
+    hist = run_stepped(plant, _FusedGroups(groups, rows), law, observers=observers, prior=sc.timing == "prior",
+                       progress=progress, desc=f"closed loop ({', '.join(p[1] for p in pairs)})")
+    pas = observers[0].h if n_passive else {}
     results = [None] * nv
     first = 0
     for v, ((s, kind), sl) in enumerate(zip(pairs, slices)):
         grp = next(g for g in groups if g[0].start <= sl.start < g[0].stop)
         settings = dict(s.readings, controller=kind, runs=runs, seed=seed, n_steps=s.n_steps, dt=s.dt, w_d=s.w_d,
                         steady_tol=s.steady_tol, fused_steady_from_step=grp[3],
-                        clipped_input_steps=int(clipped[v]), theta_alg1=float(grp[1].alg1.theta),
+                        clipped_input_steps=int(law.clipped[v]), theta_alg1=float(grp[1].alg1.theta),
                         theta_alg2=grp[1].alg2.theta.tolist())
         if flags[v] and n_passive:
             pv = {name: h[first:first + runs] for name, h in pas.items()}
             first += runs
         else:
             pv = {}
-        results[order[v]] = LoopResult(t=t, x=x_h[sl], f=fs_v[v], u=u_h[sl], drive=g_h[sl], acc=acc_h[sl],
-                                       xhat=xhat_h[sl], passive=pv, reference=ref, settings=settings)
+        results[order[v]] = LoopResult(t=t, x=hist.x[sl], f=fs_v[v], u=hist.u[sl], drive=plant.drive[sl],
+                                       acc=plant.acc[sl], xhat=hist.xhat[sl], passive=pv, reference=ref, settings=settings)
     return results
