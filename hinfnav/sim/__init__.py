@@ -1,4 +1,4 @@
-"""Simulation layer: truths (linear and nonlinear), the one Monte Carlo engine and its uses."""
+"""Simulation layer: truths (linear and nonlinear), the one Monte Carlo engine, the one stepped closed loop and their uses."""
 
 from typing import TYPE_CHECKING
 
@@ -9,6 +9,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .engine import HistorySink, Sink, run_monte_carlo
     from .montecarlo import resolve_estimator, run_estimator, simulate, simulate_batches
     from .result import SimulationResult
+    from .stepped import run_stepped
     from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "run_monte_carlo",
     "HistorySink",
     "Sink",
+    "run_stepped",
     "child_rngs",
     "noise_models",
     "draw_noise",

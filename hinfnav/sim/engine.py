@@ -12,6 +12,16 @@ through (:func:`~hinfnav.sim.simulate`, :func:`~hinfnav.sim.simulate_nonlinear`,
                       driven by the same noise draws (common random numbers again)
         sink.add(name, start, truth, history) for each estimator
 
+The closed loop's steps are those of :func:`~hinfnav.sim.stepped.run_stepped`,
+the package's one per-step loop (measure → estimator update → controller →
+record → passive observers → estimator predict → plant step), here with the
+hooks :class:`~hinfnav.sim.stepped.ModelPlant` (the truth model's plant, the
+noise given as whole histories) and :class:`~hinfnav.sim.stepped.EstimatorStage`
+(one estimator) in :func:`closed_loop_batch`. A paper's own closed loop
+(another plant and sensors, a noise drawn in blocks, several estimators on
+groups of rows, a stateful law, observers alongside) passes its own hooks to
+the same driver.
+
 Randomness: run r draws from the r-th child of ``numpy.random.default_rng(seed)``
 (:func:`~hinfnav.sim.truth.child_rngs`), w first then v, whole histories at
 once, in the open and in the closed loop alike: the numbers of run r do not
@@ -252,7 +262,9 @@ def closed_loop_batch(model: TruthModel, estimator: Estimator, controller: Calla
     At each t_k the plant is measured, the estimator updates with y_k and
     reports x̂_k, the controller computes u_k (from x̂_k, or from the true x_k
     when its ``source`` is ``"truth"``), the plant moves (``propagate`` of a
-    linear system, ``step`` of a nonlinear one) and the estimator predicts with u_k.
+    linear system, ``step`` of a nonlinear one) and the estimator predicts with u_k:
+    :func:`~hinfnav.sim.stepped.run_stepped` with a :class:`~hinfnav.sim.stepped.ModelPlant`
+    and an :class:`~hinfnav.sim.stepped.EstimatorStage`.
     """
     plant = ModelPlant(model, w, v)
     stage = EstimatorStage(estimator, np.asarray(xhat0, dtype=float), P0, keep_covariance=keep_covariance,

@@ -27,6 +27,14 @@ moves with (u_k). (Before issue 22 L1/L2/L3 also predicted with u_{k−1}.)
 Randomness: run r draws from the r-th child of ``numpy.random.default_rng(seed)``,
 in blocks of ``BLOCK`` steps, w (9) then d (9) then d_a (3) per block: the same
 seed gives the same numbers whatever the number of runs.
+
+The steps themselves are the package's one stepped loop,
+:func:`hinfnav.sim.stepped.run_stepped`; this module gives it the loop's hooks:
+the plant with its sensors and the block noise draw (``_Plant``: (4), (5),
+(11), (14)), Algorithm 3 per group of rows with equal readings
+(``_FusedGroups``), the stacked ADRC law with the attitude command
+(``_Law``: (44)-(46)) and the standalone estimators as a passive observer
+(``_Passive``).
 """
 
 from dataclasses import dataclass, field, replace
