@@ -29,6 +29,7 @@ import pytest
 import hinfnav as hn
 import hinfnav.papers
 from hinfnav.estimators import RecursiveHInfinityFilter, build_estimator, registered_estimators
+from hinfnav.estimators import compiled
 from hinfnav.estimators.compiled import kernel_status, select_backend
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
 from hinfnav.papers.shi2018 import Scenario as ShiScenario
@@ -72,9 +73,11 @@ def _built(name, on_sun=False):
 
 @pytest.fixture(scope="module")
 def chaser_truth():
-    truth = simulate_truth(SUN.truth_model(maneuver=True), runs=3, seed=7)
+    # 11 runs: a block of compiled_lanes.LANES = 8 runs advanced together and 3 runs one at a time
+    truth = simulate_truth(SUN.truth_model(maneuver=True), runs=11, seed=7)
     y = truth.y.copy()
-    y[1, 100] += 40.0 * np.sqrt(np.diag(SUN.measurement.R))  # an outlier: Huber's iterations, strong tracking's fading
+    for r in (1, 9):  # an outlier in the block and one in the rest: Huber's iterations, strong tracking's fading
+        y[r, 100] += 40.0 * np.sqrt(np.diag(SUN.measurement.R))
     return y, truth.u
 
 
@@ -105,6 +108,8 @@ def test_numba_equals_numpy(chaser_truth):
     # ONE test item for every kernel call: under pytest-xdist the kernels then compile in one worker only
     # (a cold cache costs ~20 s of CPU per worker that compiles them).
     y, u = chaser_truth
+    lanes = compiled._kernels().LANES  # numba imported here, not at collection
+    assert y.shape[0] > lanes and y.shape[0] % lanes  # both the blocked and the one-run loops run
     for name in sorted(WITH_KERNEL):
         est = _built(name, on_sun=True)
         ref = est.estimate(y, u, SUN.xhat0)

@@ -192,6 +192,7 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
         n = F.shape[0]
     elif kind == "sigma_point":
         F, G, n_rep, n = est.system.Phi, est.system.Gamma if use_input else None, est.n_state, est.n_state
+        shared = True  # on a linear model the covariance recursion does not depend on the data
     else:
         F, G, n_rep, n = est.F, est.Gamma, est.n_state, est.n_state
         shared = True
