@@ -16,7 +16,7 @@ this module, delete the kernels' cache (``__pycache__/compiled_*.nbi``/``.nbc`` 
 import numpy as np
 from numba import njit
 
-from .compiled_linalg import (chol, chol_solve, inv_to, lin, maxabs, mm, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
+from .compiled_linalg import (chol, chol_solve, chol_to, inv_to, lin, maxabs, mm, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
                               tri_inv)
 
 __all__ = ["huber_to"]
@@ -267,14 +267,14 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
 
 
 @njit(cache=True, error_model="numpy")
-def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, Pp, dx):
+def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, Pp, dx, LP, z):
     """Huber's correction (huber_correct with x_prior 0) into Pp and dx; False if a factorisation fails.
 
     The Kalman solution ``c = (C + I)⁻¹ e``, ``δx = P Aᵀ c`` first (C = A P Aᵀ,
     e = L_R⁻¹ ν); when every whitened residual, measurement ``C c − e`` and prior
     ``L_P⁻¹ δx``, is within gamma (the prior rows checked by ``cᵀ C c ≤ γ²``
     first, as huber_correct does) it is the M-estimate; otherwise the whole
-    regression is minimised (:func:`_huber_general`).
+    regression is minimised (:func:`_huber_general`). LP (n, n) and z (n) are scratch.
     """
     n = P.shape[0]
     m = A.shape[0]
@@ -299,15 +299,13 @@ def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, 
         if not abs(Cc[i] - e[i]) <= gamma:
             inside = False
     if inside and cCc > gamma * gamma:  # a prior row may be beyond gamma: L_P⁻¹ δx
-        L_P, ok = chol(P)
-        if not ok:
+        if not chol_to(P, LP):
             return False
-        z = dx.copy()
         for i in range(n):
-            s = z[i]
+            s = dx[i]
             for k in range(i):
-                s -= L_P[i, k] * z[k]
-            z[i] = s / L_P[i, i]
+                s -= LP[i, k] * z[k]
+            z[i] = s / LP[i, i]
             if not abs(z[i]) <= gamma:
                 inside = False
     if not inside and _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):

@@ -13,9 +13,9 @@ are those of the NumPy reference, numbered as there:
   :func:`hinfnav.estimators.huber_regression.minimise`); optionally strong
   tracking's deferred prior (S1)-(S4) (:mod:`hinfnav.estimators.adaptive`).
   With ``shared`` the covariance and gain do not depend on the data: one
-  recursion serves every run. Without Huber's correction the runs with a
-  covariance each go in blocks (:func:`.compiled_lanes.kalman_lanes`), the
-  runs past the last whole block one at a time here.
+  recursion serves every run. Otherwise the runs go in blocks
+  (:func:`.compiled_lanes.kalman_lanes`), the runs past the last whole
+  block one at a time here.
 * :func:`sigma_point_batch` — the unscented/cubature filter (U1)-(U5) of
   :mod:`hinfnav.estimators.sigma_point` on a linear model (one covariance
   recursion for every run, as the Kalman filter's).
@@ -161,6 +161,7 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
     S, Lm, Si = np.empty((m, m)), np.zeros((m, m)), np.empty((m, m))
     T1, T2, Pp, P, PPT = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
     x, xp, dx, nu, e, c, Cc = np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    dx0 = np.empty(n)
     if shared:  # the data-independent gain sequence, once
         K_seq = np.empty((steps, n, m))
         P[:] = P0
@@ -179,12 +180,10 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
             return False
         return shared_means(K_seq, np.zeros((steps, m)), np.zeros((steps, n)), F, G, H, x0, y, u, use_input,
                             filtered, False, n_rep, xhat)
-    r_start = 0
-    if not huber:  # a covariance per run: whole blocks of runs together, the rest below
-        r_start = runs - runs % LANES
-        if r_start and not kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, strong, rho, beta, a,
-                                        n_rep, keep, xhat, Pdiag, Pfull):
-            return False
+    r_start = runs - runs % LANES  # a covariance per run: whole blocks of runs together, the rest below
+    if r_start and not kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, gamma, tol,
+                                    max_iter, strong, rho, beta, a, n_rep, keep, xhat, Pdiag, Pfull):
+        return False
     A = mm(LRi, H) if huber else H
     HQH = mmt(mm(H, Qd), H)
     trRQ, trR = np.trace(HQH), np.trace(R)
@@ -202,7 +201,7 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
                 _moment_to(V0, nu, rho[r], k == 1)
                 _fade_to(PPT, Qd, H, trRQ, V0, beta[r], trR, a, PHt, P)
             if huber:
-                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx)
+                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx, T2, dx0)
             else:
                 ok = _joseph_to(P, H, R, nu, symmetrize, PHT, S, Lm, Si, K, T1, T2, KR, Pp, dx)
             if not ok or not finite(Pp) or not finite(dx):

@@ -27,6 +27,8 @@ this module, delete the kernels' cache (``__pycache__/compiled_*.nbi``/``.nbc`` 
 import numpy as np
 from numba import njit
 
+from .compiled_huber import huber_to
+
 __all__ = ["LANES", "kalman_lanes", "shared_means"]
 
 #: Runs advanced together (a compile-time constant: the innermost loops have this fixed length).
@@ -365,11 +367,17 @@ def _fade(PPT, Qd, H, trRQ, V0, beta, trR, a, PHt, P, s, c):
 
 
 @njit(cache=True, error_model="numpy")
-def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, strong, rho, beta, a, n_rep, keep, xhat,
-                 Pdiag, Pfull):
-    """The Kalman core with a covariance per run (Joseph update, optionally strong tracking) of the runs in
-    whole blocks of :data:`LANES` (the first ``runs − runs % LANES``); fills their xhat, Pdiag/Pfull; False when
-    an S is not definite or a number not finite."""
+def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, gamma, tol, max_iter, strong, rho,
+                 beta, a, n_rep, keep, xhat, Pdiag, Pfull):
+    """The Kalman core with a covariance per run of the runs in whole blocks of :data:`LANES` (the first
+    ``runs − runs % LANES``); fills their xhat, Pdiag/Pfull; False when an S is not definite or a number not
+    finite.
+
+    The Joseph update (J1)-(J2) in lanes, or Huber's correction run by run
+    (:func:`.compiled_huber.huber_to`, its iterations depend on the run's
+    data) on copies of each run's P and ν; optionally strong tracking's
+    fading; the prediction in lanes.
+    """
     runs, steps, m = y.shape
     n = F.shape[0]
     L = LANES
@@ -379,6 +387,15 @@ def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, strong, rho,
     PHT, K, KR, T1 = np.empty((n, m, L)), np.empty((n, m, L)), np.empty((n, m, L)), np.empty((n, m, L))
     S, Lm, Si, V0 = np.empty((m, m, L)), np.zeros((m, m, L)), np.empty((m, m, L)), np.zeros((m, m, L))
     rb, bb = np.empty(L), np.empty(L)
+    A = np.zeros((m, n))  # Huber's whitened measurement matrix L_R⁻¹ H and the one-run scratch of huber_to
+    for i in range(m):
+        for j in range(n):
+            for t in range(m):
+                A[i, j] += LRi[i, t] * H[t, j]
+    P1, Pp1, dx1, nu1, e1, c1, Cc1 = (np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(m), np.empty(m),
+                                      np.empty(m), np.empty(m))
+    PAT1, KW1, C1, Lm1, Si1 = np.empty((n, m)), np.empty((n, m)), np.empty((m, m)), np.zeros((m, m)), np.empty((m, m))
+    LP1, z1 = np.zeros((n, n)), np.empty(n)
     HQ = np.zeros((m, n))
     for i in range(m):  # tr(H Q_d Hᵀ)
         for j in range(n):
@@ -411,7 +428,21 @@ def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, strong, rho,
                             gg = nu[i, b] * nu[j, b]
                             V0[i, j, b] = gg if k == 1 else (rb[b] * V0[i, j, b] + gg) / (1.0 + rb[b])
                 _fade(PPT, Qd, H, trRQ, V0, bb, trR, a, PHt=KR, P=P, s=s, c=c)
-            if _joseph(P, H, R, nu, PHT, S, Lm, Si, K, T2, KR, T1, Pp, dx, s):
+            if huber:
+                for b in range(L):
+                    for i in range(n):
+                        for j in range(n):
+                            P1[i, j] = P[i, j, b]
+                    for i in range(m):
+                        nu1[i] = nu[i, b]
+                    if not huber_to(P1, A, LRi, nu1, gamma, tol, max_iter, e1, PAT1, C1, Lm1, Si1, c1, Cc1, KW1, Pp1,
+                                    dx1, LP1, z1):
+                        return False
+                    for i in range(n):
+                        dx[i, b] = dx1[i]
+                        for j in range(n):
+                            Pp[i, j, b] = Pp1[i, j]
+            elif _joseph(P, H, R, nu, PHT, S, Lm, Si, K, T2, KR, T1, Pp, dx, s):
                 return False
             for b in range(L):  # one sum per run: not finite when any of its entries is not
                 s[b] = 0.0
