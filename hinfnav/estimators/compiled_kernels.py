@@ -161,7 +161,7 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
     S, Lm, Si = np.empty((m, m)), np.zeros((m, m)), np.empty((m, m))
     T1, T2, Pp, P, PPT = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
     x, xp, dx, nu, e, c, Cc = np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(m), np.empty(m)
-    dx0 = np.empty(n)
+    dx0, wm, wmm, wnm = np.empty(n), np.empty((8, m)), np.empty((3, m, m)), np.empty((2, n, m))  # Huber's scratch
     if shared:  # the data-independent gain sequence, once
         K_seq = np.empty((steps, n, m))
         P[:] = P0
@@ -201,7 +201,8 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
                 _moment_to(V0, nu, rho[r], k == 1)
                 _fade_to(PPT, Qd, H, trRQ, V0, beta[r], trR, a, PHt, P)
             if huber:
-                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx, T2, dx0)
+                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx, T2, dx0,
+                              wm, wmm, wnm)
             else:
                 ok = _joseph_to(P, H, R, nu, symmetrize, PHT, S, Lm, Si, K, T1, T2, KR, Pp, dx)
             if not ok or not finite(Pp) or not finite(dx):

@@ -395,7 +395,7 @@ def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, 
     P1, Pp1, dx1, nu1, e1, c1, Cc1 = (np.empty((n, n)), np.empty((n, n)), np.empty(n), np.empty(m), np.empty(m),
                                       np.empty(m), np.empty(m))
     PAT1, KW1, C1, Lm1, Si1 = np.empty((n, m)), np.empty((n, m)), np.empty((m, m)), np.zeros((m, m)), np.empty((m, m))
-    LP1, z1 = np.zeros((n, n)), np.empty(n)
+    LP1, z1, wm1, wmm1, wnm1 = np.zeros((n, n)), np.empty(n), np.empty((8, m)), np.empty((3, m, m)), np.empty((2, n, m))
     HQ = np.zeros((m, n))
     for i in range(m):  # tr(H Q_d Hᵀ)
         for j in range(n):
@@ -436,7 +436,7 @@ def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, 
                     for i in range(m):
                         nu1[i] = nu[i, b]
                     if not huber_to(P1, A, LRi, nu1, gamma, tol, max_iter, e1, PAT1, C1, Lm1, Si1, c1, Cc1, KW1, Pp1,
-                                    dx1, LP1, z1):
+                                    dx1, LP1, z1, wm1, wmm1, wnm1):
                         return False
                     for i in range(n):
                         dx[i, b] = dx1[i]
