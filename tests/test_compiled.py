@@ -14,8 +14,8 @@ M-estimation's iterations, the strong-tracking fading) are both exercised.
 
 CPU: the kernels compile once per installation (numba's on-disk cache, about
 20 s of CPU for the Kalman kernel and 2-3 s each for the others on the
-README's machine); this file takes about 33 s of CPU from an empty cache and
-10 s from a filled one. Every kernel call is in ONE test item so that under
+README's machine); this file takes about 39 s of CPU from an empty cache and
+8 s from a filled one. Every kernel call is in ONE test item so that under
 pytest-xdist one worker only compiles.
 """
 
