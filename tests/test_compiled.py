@@ -28,7 +28,7 @@ import pytest
 
 import hinfnav as hn
 import hinfnav.papers
-from hinfnav.estimators import RecursiveHInfinityFilter, build_estimator, registered_estimators
+from hinfnav.estimators import RecursiveHInfinityFilter, SigmaPointFilter, build_estimator, registered_estimators
 from hinfnav.estimators import compiled
 from hinfnav.estimators.compiled import kernel_status, select_backend
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
@@ -115,6 +115,11 @@ def test_numba_equals_numpy(chaser_truth):
         ref = est.estimate(y, u, SUN.xhat0)
         _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"), name)
         assert select_backend(est, "auto") == "numba"
+    # the sigma-point kernel computes the points' deviations about zero, once for all runs: other weights too
+    # (the cubature rule; alpha = 0.5, a negative centre weight), the same NumPy reference to 1e-10
+    for options in ({"rule": "cubature"}, {"alpha": 0.5, "kappa": 1.0}):
+        est = SigmaPointFilter.from_ekf(_built("ekf_known_input", on_sun=True), **options)
+        _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), str(options))
     for keep in (False, "diagonal"):  # the covariance kept as asked
         for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
             est = _built(name, on_sun=True)
