@@ -28,12 +28,15 @@ import pytest
 
 import hinfnav as hn
 import hinfnav.papers
-from hinfnav.estimators import RecursiveHInfinityFilter, SigmaPointFilter, build_estimator, registered_estimators
+from hinfnav.estimators import (AugmentedInputHuberSTKF, RecursiveHInfinityFilter, SigmaPointFilter, build_estimator,
+                                registered_estimators)
 from hinfnav.estimators import compiled
 from hinfnav.estimators.compiled import kernel_status, select_backend
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
+from hinfnav.papers.attitude2018.chaser import P0_THRUST_STD, Q_THRUST_BASE
 from hinfnav.papers.shi2018 import Scenario as ShiScenario
 from hinfnav.papers.sun2011 import Scenario
+from hinfnav.papers.sun2011.constants import DEFAULT_P0_STD
 from hinfnav.papers.yang2020 import SUBSYSTEM_OF
 from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.sim import simulate_truth
@@ -120,6 +123,12 @@ def test_numba_equals_numpy(chaser_truth):
     for options in ({"rule": "cubature"}, {"alpha": 0.5, "kappa": 1.0}):
         est = SigmaPointFilter.from_ekf(_built("ekf_known_input", on_sun=True), **options)
         _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), str(options))
+    # Huber x strong tracking on the augmented model (no registered name on the chaser): fading, then Huber's correction
+    st = _built("ekf_augmented_thrust_st", on_sun=True)
+    est = AugmentedInputHuberSTKF(st.system, st.measurement, Q_input=Q_THRUST_BASE * np.eye(3),
+                                  P0=np.diag(DEFAULT_P0_STD**2), P0_input=np.eye(3) * P0_THRUST_STD**2, rho=0.95, beta=1.0)
+    assert kernel_status(est) is None
+    _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), "huber x st")
     for keep in (False, "diagonal"):  # the covariance kept as asked
         for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
             est = _built(name, on_sun=True)
