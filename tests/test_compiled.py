@@ -14,8 +14,8 @@ M-estimation's iterations, the strong-tracking fading) are both exercised.
 
 CPU: the kernels compile once per installation (numba's on-disk cache, about
 20 s of CPU for the Kalman kernel and 2-3 s each for the others on the
-README's machine); this file takes about 33 s of CPU from an empty cache and
-10 s from a filled one. Every kernel call is in ONE test item so that under
+README's machine); this file takes about 39 s of CPU from an empty cache and
+8 s from a filled one. Every kernel call is in ONE test item so that under
 pytest-xdist one worker only compiles.
 """
 
@@ -28,11 +28,15 @@ import pytest
 
 import hinfnav as hn
 import hinfnav.papers
-from hinfnav.estimators import RecursiveHInfinityFilter, build_estimator, registered_estimators
+from hinfnav.estimators import (AugmentedInputHuberSTKF, RecursiveHInfinityFilter, SigmaPointFilter, build_estimator,
+                                registered_estimators)
+from hinfnav.estimators import compiled
 from hinfnav.estimators.compiled import kernel_status, select_backend
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
+from hinfnav.papers.attitude2018.chaser import P0_THRUST_STD, Q_THRUST_BASE
 from hinfnav.papers.shi2018 import Scenario as ShiScenario
 from hinfnav.papers.sun2011 import Scenario
+from hinfnav.papers.sun2011.constants import DEFAULT_P0_STD
 from hinfnav.papers.yang2020 import SUBSYSTEM_OF
 from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.sim import simulate_truth
@@ -72,9 +76,11 @@ def _built(name, on_sun=False):
 
 @pytest.fixture(scope="module")
 def chaser_truth():
-    truth = simulate_truth(SUN.truth_model(maneuver=True), runs=3, seed=7)
+    # 11 runs: a block of compiled_lanes.LANES = 8 runs advanced together and 3 runs one at a time
+    truth = simulate_truth(SUN.truth_model(maneuver=True), runs=11, seed=7)
     y = truth.y.copy()
-    y[1, 100] += 40.0 * np.sqrt(np.diag(SUN.measurement.R))  # an outlier: Huber's iterations, strong tracking's fading
+    for r in (1, 9):  # an outlier in the block and one in the rest: Huber's iterations, strong tracking's fading
+        y[r, 100] += 40.0 * np.sqrt(np.diag(SUN.measurement.R))
     return y, truth.u
 
 
@@ -105,11 +111,24 @@ def test_numba_equals_numpy(chaser_truth):
     # ONE test item for every kernel call: under pytest-xdist the kernels then compile in one worker only
     # (a cold cache costs ~20 s of CPU per worker that compiles them).
     y, u = chaser_truth
+    lanes = compiled._kernels().LANES  # numba imported here, not at collection
+    assert y.shape[0] > lanes and y.shape[0] % lanes  # both the blocked and the one-run loops run
     for name in sorted(WITH_KERNEL):
         est = _built(name, on_sun=True)
         ref = est.estimate(y, u, SUN.xhat0)
         _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"), name)
         assert select_backend(est, "auto") == "numba"
+    # the sigma-point kernel computes the points' deviations about zero, once for all runs: other weights too
+    # (the cubature rule; alpha = 0.5, a negative centre weight), the same NumPy reference to 1e-10
+    for options in ({"rule": "cubature"}, {"alpha": 0.5, "kappa": 1.0}):
+        est = SigmaPointFilter.from_ekf(_built("ekf_known_input", on_sun=True), **options)
+        _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), str(options))
+    # Huber x strong tracking on the augmented model (no registered name on the chaser): fading, then Huber's correction
+    st = _built("ekf_augmented_thrust_st", on_sun=True)
+    est = AugmentedInputHuberSTKF(st.system, st.measurement, Q_input=Q_THRUST_BASE * np.eye(3),
+                                  P0=np.diag(DEFAULT_P0_STD**2), P0_input=np.eye(3) * P0_THRUST_STD**2, rho=0.95, beta=1.0)
+    assert kernel_status(est) is None
+    _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), "huber x st")
     for keep in (False, "diagonal"):  # the covariance kept as asked
         for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
             est = _built(name, on_sun=True)

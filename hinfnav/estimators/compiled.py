@@ -15,7 +15,12 @@
 The kernels give the NumPy path's estimates and covariances to 1e-10 relative
 (``tests/test_compiled.py`` checks every registered estimator); the
 equations are the same, only the order of the floating-point sums and, in the
-Huber M-estimation, the route to the same minimiser differ. A kernel that
+Huber M-estimation, the route to the same minimiser differ. What does not
+depend on the data is computed once for the batch: the gains of the Kalman,
+sigma-point (on a linear model its covariances do not depend on the state)
+and recursive H∞ filters; the runs with a covariance each (strong tracking,
+Huber) advance in blocks of eight, every product's innermost loop over the
+block (:mod:`hinfnav.estimators.compiled_lanes`). A kernel that
 meets a failed factorisation or a non-finite number hands the batch back to
 the NumPy path, which raises its own error (or flags, as it is told).
 
@@ -23,8 +28,8 @@ numba is imported only when a kernel is first asked for (importing it costs
 about 1 s); the kernels are compiled with ``cache=True`` (numba's on-disk
 cache, in ``__pycache__`` beside the kernels' module, or ``NUMBA_CACHE_DIR``),
 so the compilation is paid once per installation: the first call of the five
-filters of the README's speed table in a new process costs about 26 s of CPU
-from an empty cache and 0.5 s from a filled one (``python
+filters of the README's speed table in a new process costs about 32 s of CPU
+from an empty cache and 0.4 s from a filled one (``python
 benchmarks/speed_table.py --compile-cost``, on the README's machine under
 load).
 """
@@ -164,7 +169,8 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     as :func:`~hinfnav.estimators.base.check_estimator_inputs` returns them.
     The P history is (runs, n_samples, n, n) (its diagonal with
     ``keep_covariance="diagonal"``, None with False), a read-only broadcast
-    when the covariance is shared by every run (as on the NumPy path).
+    when the covariance is shared by every run (as on the NumPy path of the Kalman filters; the sigma-point
+    filter's NumPy path returns a copy per run).
     """
     kern = _kernels()
     kind = _kind(est)
@@ -192,6 +198,7 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
         n = F.shape[0]
     elif kind == "sigma_point":
         F, G, n_rep, n = est.system.Phi, est.system.Gamma if use_input else None, est.n_state, est.n_state
+        shared = True  # on a linear model the covariance recursion does not depend on the data
     else:
         F, G, n_rep, n = est.F, est.Gamma, est.n_state, est.n_state
         shared = True

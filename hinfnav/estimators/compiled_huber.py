@@ -16,7 +16,7 @@ this module, delete the kernels' cache (``__pycache__/compiled_*.nbi``/``.nbc`` 
 import numpy as np
 from numba import njit
 
-from .compiled_linalg import (chol, chol_solve, inv_to, lin, maxabs, mm, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
+from .compiled_linalg import (chol, chol_solve, chol_to, inv_to, lin, maxabs, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
                               tri_inv)
 
 __all__ = ["huber_to"]
@@ -158,14 +158,13 @@ def _minimise(M, yv, x, gamma, tol, max_iter):
 
 
 @njit(cache=True, error_model="numpy")
-def _inv_eye_plus_scaled(C, E):
-    """T⁻¹ for T = I + diag(E) C diag(E), and whether T was positive definite (Cholesky)."""
+def _inv_eye_plus_scaled(C, E, T, Lt, Ti):
+    """Ti = T⁻¹ for T = I + diag(E) C diag(E) (no allocation); False if T is not positive definite."""
     m = E.shape[0]
-    T = np.empty((m, m))
     for i in range(m):
         for j in range(m):
             T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
-    return spd_inv(T)
+    return inv_to(T, Lt, Ti)
 
 
 @njit(cache=True, error_model="numpy")
@@ -200,7 +199,7 @@ def _huber_general(P, A, e, dx, gamma, tol, max_iter):
 
 
 @njit(cache=True, error_model="numpy")
-def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
+def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx, LP, ATc, wm, wmm, wnm):
     """The first Newton point in the measurement space (huber.py's ``_minimise_measurement_space``).
 
     From the Kalman point c, the Newton point of the current split of the
@@ -210,27 +209,28 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
     and keeps every prior row ``L_Pᵀ Aᵀ c`` within gamma it is the minimiser:
     ``δx = P Aᵀ c`` and ``P⁺ = P − U (E_w C E_w + I)⁻¹ Uᵀ`` (``U = P Aᵀ E_w``,
     ``E_w = diag(√ψ)``) are written and True returned; otherwise False.
+    Scratch (no allocation): LP (n, n), ATc (n), wm (8, m), wmm (3, m, m), wnm (2, n, m).
     """
     m = C.shape[0]
     n = P.shape[0]
     slack = 1e-12 * gamma
-    zm, grad, E = np.empty(m), np.empty(m), np.empty(m)
+    zm, grad, E, Cg, w, cand, zc = wm[0], wm[1], wm[2], wm[3], wm[4], wm[5], wm[6]
+    T, Lt, Ti = wmm[0], wmm[1], wmm[2]
+    U, UTi = wnm[0], wnm[1]
     for i in range(m):
         zm[i] = Cc[i] - e[i]
         q = abs(zm[i]) <= gamma
         grad[i] = c[i] + (zm[i] if q else gamma * np.sign(zm[i]))
         E[i] = 1.0 if q else 0.0
-    Ti, ok = _inv_eye_plus_scaled(C, E)
-    if not ok:
+    if not _inv_eye_plus_scaled(C, E, T, Lt, Ti):
         return False
-    Cg = mv(C, grad)
+    mv_to(C, grad, Cg)
     for i in range(m):
         Cg[i] *= E[i]
-    w = mv(Ti, Cg)
-    cand = np.empty(m)
+    mv_to(Ti, Cg, w)
     for i in range(m):
         cand[i] = c[i] - (grad[i] - E[i] * w[i])
-    zc = mv(C, cand)
+    mv_to(C, cand, zc)
     for i in range(m):
         zc[i] -= e[i]
         if E[i] == 1.0:
@@ -238,43 +238,43 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
                 return False
         elif not np.sign(zm[i]) * zc[i] >= gamma - slack:
             return False
-    L_P, ok = chol(P)
-    if not ok:
+    if not chol_to(P, LP):
         return False
-    ATc = np.zeros(n)
+    for j in range(n):
+        ATc[j] = 0.0
     for i in range(m):
         for j in range(n):
             ATc[j] += A[i, j] * cand[i]
     for j in range(n):  # prior rows L_Pᵀ Aᵀ c: beyond gamma (weight < 1), the whole regression decides
         s = 0.0
         for k in range(j, n):
-            s += L_P[k, j] * ATc[k]
+            s += LP[k, j] * ATc[k]
         if not abs(s) <= gamma:
             return False
-    psi = _psi(zc, gamma)
-    for i in range(m):
-        E[i] = np.sqrt(psi[i])
-    Ti, ok = _inv_eye_plus_scaled(C, E)
-    if not ok:
+    for i in range(m):  # E_w = diag(√ψ(z_c)) (_psi's weights)
+        a = abs(zc[i])
+        E[i] = np.sqrt(1.0 if a <= gamma else gamma / max(a, gamma))
+    if not _inv_eye_plus_scaled(C, E, T, Lt, Ti):
         return False
-    U = np.empty((n, m))
     for i in range(n):
         for j in range(m):
             U[i, j] = PAT[i, j] * E[j]
-    _minus_outer(P, mm(U, Ti), U, Pp)
+    mm_to(U, Ti, UTi)
+    _minus_outer(P, UTi, U, Pp)
     mv_to(PAT, cand, dx)
     return True
 
 
 @njit(cache=True, error_model="numpy")
-def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, Pp, dx):
+def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, Pp, dx, LP, z, wm, wmm, wnm):
     """Huber's correction (huber_correct with x_prior 0) into Pp and dx; False if a factorisation fails.
 
     The Kalman solution ``c = (C + I)⁻¹ e``, ``δx = P Aᵀ c`` first (C = A P Aᵀ,
     e = L_R⁻¹ ν); when every whitened residual, measurement ``C c − e`` and prior
     ``L_P⁻¹ δx``, is within gamma (the prior rows checked by ``cᵀ C c ≤ γ²``
     first, as huber_correct does) it is the M-estimate; otherwise the whole
-    regression is minimised (:func:`_huber_general`).
+    regression is minimised (:func:`_huber_general`). LP (n, n), z (n), wm (8, m), wmm (3, m, m) and
+    wnm (2, n, m) are scratch.
     """
     n = P.shape[0]
     m = A.shape[0]
@@ -299,18 +299,16 @@ def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, 
         if not abs(Cc[i] - e[i]) <= gamma:
             inside = False
     if inside and cCc > gamma * gamma:  # a prior row may be beyond gamma: L_P⁻¹ δx
-        L_P, ok = chol(P)
-        if not ok:
+        if not chol_to(P, LP):
             return False
-        z = dx.copy()
         for i in range(n):
-            s = z[i]
+            s = dx[i]
             for k in range(i):
-                s -= L_P[i, k] * z[k]
-            z[i] = s / L_P[i, i]
+                s -= LP[i, k] * z[k]
+            z[i] = s / LP[i, i]
             if not abs(z[i]) <= gamma:
                 inside = False
-    if not inside and _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx):
+    if not inside and _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx, LP, z, wm, wmm, wnm):
         return True
     if not inside:
         dx2, Pp2, ok = _huber_general(P, A, e, dx.copy(), gamma, tol, max_iter)

@@ -13,16 +13,20 @@ are those of the NumPy reference, numbered as there:
   :func:`hinfnav.estimators.huber_regression.minimise`); optionally strong
   tracking's deferred prior (S1)-(S4) (:mod:`hinfnav.estimators.adaptive`).
   With ``shared`` the covariance and gain do not depend on the data: one
-  recursion serves every run.
+  recursion serves every run. Otherwise the runs go in blocks
+  (:func:`.compiled_lanes.kalman_lanes`), the runs past the last whole
+  block one at a time here.
 * :func:`sigma_point_batch` — the unscented/cubature filter (U1)-(U5) of
-  :mod:`hinfnav.estimators.sigma_point` on a linear model.
+  :mod:`hinfnav.estimators.sigma_point` on a linear model (one covariance
+  recursion for every run, as the Kalman filter's).
 * :func:`recursive_hinf_batch` — Simon's a-priori recursive H∞ filter
   (:mod:`hinfnav.estimators.recursive_hinf`), gain recursion with the steady
   freeze, then the mean recursion of every run.
 
 The small linear algebra is in :mod:`.compiled_linalg`, Huber's correction
-in :mod:`.compiled_huber` (numba's cache does not see a change there: see
-their docstrings).
+in :mod:`.compiled_huber`, the loops over blocks of runs (and every shared
+gain's mean recursion) in :mod:`.compiled_lanes` (numba's cache does not see
+a change there: see their docstrings).
 
 Each returns False when a factorisation fails or a number is not finite; the
 caller then runs the NumPy reference, which raises its own error.
@@ -32,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from .compiled_huber import huber_to
+from .compiled_lanes import LANES, kalman_lanes, shared_means
 from .compiled_linalg import (chol, chol_solve, chol_to, eye_minus, finite, inv_to, lin, mm, mm_to, mmt, mmt_sym_to,
                               mmt_to, mv_to, sym)
 
@@ -76,22 +81,6 @@ def _joseph_to(P, H, R, nu, symmetrize, PHT, S, Lm, Si, K, T1, T2, KR, Pp, dx):
                 Pp[j, i] = s
     mv_to(K, nu, dx)
     return True
-
-
-@njit(cache=True, error_model="numpy")
-def _mean_step(K, H, yk, x, xp, nu):
-    """ν = y − H x, x⁺ = x + K ν into xp (no allocation)."""
-    n, m = K.shape
-    for i in range(m):
-        s = yk[i]
-        for j in range(n):
-            s -= H[i, j] * x[j]
-        nu[i] = s
-    for i in range(n):
-        s = x[i]
-        for j in range(m):
-            s += K[i, j] * nu[j]
-        xp[i] = s
 
 
 @njit(cache=True, error_model="numpy")
@@ -172,6 +161,7 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
     S, Lm, Si = np.empty((m, m)), np.zeros((m, m)), np.empty((m, m))
     T1, T2, Pp, P, PPT = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
     x, xp, dx, nu, e, c, Cc = np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    dx0, wm, wmm, wnm = np.empty(n), np.empty((8, m)), np.empty((3, m, m)), np.empty((2, n, m))  # Huber's scratch
     if shared:  # the data-independent gain sequence, once
         K_seq = np.empty((steps, n, m))
         P[:] = P0
@@ -188,19 +178,17 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
                         P[i, j] += Qd[i, j]
         if not finite(K_seq):
             return False
-        for r in range(runs):
-            x[:] = x0
-            for k in range(steps):
-                _mean_step(K_seq[k], H, y[r, k], x, xp, nu)
-                _store(xhat, r, k, xp if filtered else x, n_rep)
-                if k < steps - 1:
-                    _propagate_to(F, G, u[r, k], xp, x, use_input)
-        return True
+        return shared_means(K_seq, np.zeros((steps, m)), np.zeros((steps, n)), F, G, H, x0, y, u, use_input,
+                            filtered, False, n_rep, xhat)
+    r_start = runs - runs % LANES  # a covariance per run: whole blocks of runs together, the rest below
+    if r_start and not kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, gamma, tol,
+                                    max_iter, strong, rho, beta, a, n_rep, keep, xhat, Pdiag, Pfull):
+        return False
     A = mm(LRi, H) if huber else H
     HQH = mmt(mm(H, Qd), H)
     trRQ, trR = np.trace(HQH), np.trace(R)
     V0 = np.zeros((m, m))
-    for r in range(runs):
+    for r in range(r_start, runs):
         x[:] = x0
         P[:] = P0
         for k in range(steps):
@@ -213,7 +201,8 @@ def kalman_batch(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, symmetrize, 
                 _moment_to(V0, nu, rho[r], k == 1)
                 _fade_to(PPT, Qd, H, trRQ, V0, beta[r], trR, a, PHt, P)
             if huber:
-                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx)
+                ok = huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PHT, S, Lm, Si, c, Cc, KR, Pp, dx, T2, dx0,
+                              wm, wmm, wnm)
             else:
                 ok = _joseph_to(P, H, R, nu, symmetrize, PHT, S, Lm, Si, K, T1, T2, KR, Pp, dx)
             if not ok or not finite(Pp) or not finite(dx):
@@ -269,7 +258,16 @@ def _wcov_to(Wc, A, B, out, add):
 @njit(cache=True, error_model="numpy")
 def sigma_point_batch(F, G, H, Q, R, P0, x0, y, u, use_input, filtered, Wm, Wc, scale, center, keep, xhat, Pdiag,
                       Pfull):
-    """(U1)-(U5) on a linear model, every run and step; fills xhat, Pdiag/Pfull; ok."""
+    """(U1)-(U5) on a linear model, every run and step; fills xhat, Pdiag/Pfull (one covariance: P0 is shared);
+    ok.
+
+    On a linear model the sigma points' deviations from their weighted mean
+    (``H (x + δᵢ) − ȳ``, ``F (x⁺ + δᵢ) − x̄``) do not depend on the state:
+    the covariances, the gains and the mean offsets ``Σ Wmᵢ H δᵢ``,
+    ``Σ Wmᵢ F δᵢ`` (zero but for rounding) are computed once, about zero,
+    and every run's mean follows ``ȳ = H x + Σ Wmᵢ H δᵢ``,
+    ``x̄ = F x⁺ + G u + Σ Wmᵢ F δᵢ`` (:func:`.compiled_lanes.shared_means`).
+    """
     runs, steps, m = y.shape
     n = F.shape[0]
     N = Wm.size
@@ -278,61 +276,47 @@ def sigma_point_batch(F, G, H, Q, R, P0, x0, y, u, use_input, filtered, Wm, Wc, 
     S, Lm, Si, Pxy, K, KS = (np.empty((m, m)), np.zeros((m, m)), np.empty((m, m)), np.empty((n, m)),
                              np.empty((n, m)), np.empty((n, m)))
     zero_nm = np.zeros((n, m))
-    x, xp, ym, yx, base, ref = np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(m)
-    for r in range(runs):
-        x[:] = x0
-        P[:] = P0
-        for k in range(steps):
-            if not _offsets_to(P, scale, center, A, L, D):
-                return False
-            mmt_to(D, H, Y)  # H (x + δ) = H x + H δ
-            mv_to(H, x, yx)
-            for s in range(N):
-                for i in range(m):
-                    Y[s, i] += yx[i]
+    K_seq, by, bx = np.empty((steps, n, m)), np.empty((steps, m)), np.zeros((steps, n))
+    P[:] = P0
+    for k in range(steps):
+        if not _offsets_to(P, scale, center, A, L, D):
+            return False
+        mmt_to(D, H, Y)  # H δ (the deviations about H x)
+        for i in range(m):
+            by[k, i] = 0.0
+        for s in range(N):
             for i in range(m):
-                ref[i] = Y[0, i] if center else yx[i]
-                ym[i] = ref[i]
-            for s in range(N):
-                for i in range(m):
-                    ym[i] += Wm[s] * (Y[s, i] - ref[i])
-            for s in range(N):
-                for i in range(m):
-                    Y[s, i] -= ym[i]
-            _wcov_to(Wc, Y, Y, S, R)
-            _wcov_to(Wc, D, Y, Pxy, zero_nm)
-            if not inv_to(S, Lm, Si):
+                by[k, i] += Wm[s] * Y[s, i]
+        for s in range(N):
+            for i in range(m):
+                Y[s, i] -= by[k, i]
+        _wcov_to(Wc, Y, Y, S, R)
+        _wcov_to(Wc, D, Y, Pxy, zero_nm)
+        if not inv_to(S, Lm, Si):
+            return False
+        mm_to(Pxy, Si, K)
+        K_seq[k] = K
+        mm_to(K, S, KS)
+        mmt_to(KS, K, Pp)
+        for i in range(n):
+            for j in range(n):
+                Pp[i, j] = P[i, j] - Pp[i, j]
+        sym(Pp)
+        _record(Pp if filtered else P, n, 0, k, Pdiag, Pfull, keep)
+        if k < steps - 1:
+            if not _offsets_to(Pp, scale, center, A, L, D):
                 return False
-            mm_to(Pxy, Si, K)
-            for i in range(n):
-                s = x[i]
-                for j in range(m):
-                    s += K[i, j] * (y[r, k, j] - ym[j])
-                xp[i] = s
-            mm_to(K, S, KS)
-            mmt_to(KS, K, Pp)
-            for i in range(n):
-                for j in range(n):
-                    Pp[i, j] = P[i, j] - Pp[i, j]
-            sym(Pp)
-            _store(xhat, r, k, xp if filtered else x, n)
-            _record(Pp if filtered else P, n, r, k, Pdiag, Pfull, keep)
-            if k < steps - 1:
-                if not _offsets_to(Pp, scale, center, A, L, D):
-                    return False
-                mmt_to(D, F, Xf)  # F (x + δ) + G u
-                _propagate_to(F, G, u[r, k], xp, base, use_input)
+            mmt_to(D, F, Xf)  # F δ
+            for s in range(N):
                 for i in range(n):
-                    x[i] = 0.0
-                for s in range(N):
-                    for i in range(n):
-                        Xf[s, i] += base[i]
-                        x[i] += Wm[s] * Xf[s, i]
-                for s in range(N):
-                    for i in range(n):
-                        Xf[s, i] -= x[i]
-                _wcov_to(Wc, Xf, Xf, P, Q)
-    return True
+                    bx[k, i] += Wm[s] * Xf[s, i]
+            for s in range(N):
+                for i in range(n):
+                    Xf[s, i] -= bx[k, i]
+            _wcov_to(Wc, Xf, Xf, P, Q)
+    if not (finite(K_seq) and finite(by) and finite(bx)):
+        return False
+    return shared_means(K_seq, by, bx, F, G, H, x0, y, u, use_input, filtered, False, n, xhat)
 
 
 # -- the recursive H-infinity filter ------------------------------------------------------
@@ -377,24 +361,6 @@ def recursive_hinf_batch(F, G, H, Q, Gm, HtRi, P0, x0, y, u, use_input, freeze, 
             P = Pn
     if not finite(FK):
         return False
-    x, xp, nu = np.empty(n), np.empty(n), np.empty(m)
-    I_n = np.eye(n)
-    for r in range(runs):
-        x[:] = x0
-        for k in range(steps):
-            _store(xhat, r, k, x, n)
-            # x⁺ = F x + F K (y − H x) + G u: the mean step with gain F K from x, then x = I·x⁺ + G u
-            for i in range(m):
-                s = y[r, k, i]
-                for j in range(n):
-                    s -= H[i, j] * x[j]
-                nu[i] = s
-            for i in range(n):
-                s = 0.0
-                for j in range(n):
-                    s += F[i, j] * x[j]
-                for j in range(m):
-                    s += FK[k, i, j] * nu[j]
-                xp[i] = s
-            _propagate_to(I_n, G, u[r, k], xp, x, use_input)
-    return True
+    # x⁺ = F x + F K (y − H x) + G u: the mean step with gain F K from x, then x = I·x⁺ + G u
+    return shared_means(FK, np.zeros((steps, m)), np.zeros((steps, n)), F, G, H, x0, y, u, use_input, False, True, n,
+                        xhat)
