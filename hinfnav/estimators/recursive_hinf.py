@@ -71,10 +71,14 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["RecursiveHInfinityFilter", "ExtendedHInfinityFilter", "ON_VIOLATION", "STEADY_TOL"]
+__all__ = ["RecursiveHInfinityFilter", "ExtendedHInfinityFilter", "ON_VIOLATION", "EXTENDED_ON_VIOLATION",
+           "STEADY_TOL"]
 
 #: What the filter does when the existence condition fails.
 ON_VIOLATION = ("raise", "flag")
+
+#: What the extended filter does where the existence condition fails for a run: raise, or use θ = 0 at that step.
+EXTENDED_ON_VIOLATION = ("raise", "kalman")
 
 #: Default ``steady_tol``: relative change of P per step (Frobenius) below which the steady gain is kept.
 STEADY_TOL = 1e-14
@@ -257,15 +261,19 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
         As :class:`RecursiveHInfinityFilter` (default I): S̄ = Lᵀ S L.
     output : {"predicted", "filtered"}
         What ``update`` reports: the a-priori estimate x̂_k of Simon's filter (default) or x̄_k of (X1).
+    on_violation : {"raise", "kalman"}
+        Where the existence condition fails for a run: stop with an InputError naming θ (default), or take that
+        run's step with θ = 0 (the EKF's update; documented fallback: the game has no saddle point there), which
+        ``existence_ok`` reports.
 
     Notes
     -----
     The existence condition ``P_k⁻¹ − θS̄ + H_kᵀR⁻¹H_k > 0`` is checked at every
-    step for every run (Cholesky factor of ``N = I + Cᵀ(H_kᵀR⁻¹H_k − θS̄)C``,
-    ``P_k = C Cᵀ``); where it fails the filter stops with an
-    :class:`~hinfnav.core.exceptions.InputError` naming θ. Diagnostics of
-    ``update``: ``innovation``, ``innovation_covariance`` (``H_k P_k H_kᵀ + R``)
-    and ``existence_margin`` (runs,), the smallest eigenvalue of N.
+    step for every run (``N = I + Cᵀ(H_kᵀR⁻¹H_k − θS̄)C > 0``, ``P_k = C Cᵀ``).
+    With a linearized measurement it depends on the data, so a θ admissible
+    at the initial geometry can fail in a run's transient. Diagnostics of
+    ``update``: ``innovation``, ``innovation_covariance`` (``H_k P_k H_kᵀ + R``),
+    ``existence_margin`` (runs,), the smallest eigenvalue of N, and ``existence_ok``.
     """
 
     name = "extended_hinf"
@@ -274,7 +282,7 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, theta: float,
                  P0: ArrayLike, Q: ArrayLike | None = None, R: ArrayLike | None = None, L: ArrayLike | None = None,
                  S: ArrayLike | None = None, uses_input: bool = True, output: str = "predicted",
-                 name: str | None = None, missing: str = "refuse") -> None:
+                 on_violation: str = "raise", name: str | None = None, missing: str = "refuse") -> None:
         super().__init__(system, measurement, P0=P0, Q=Q, R=R, uses_input=uses_input, output=output, name=name,
                          missing=missing)
         if self.R is None:
@@ -282,6 +290,7 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
                              "depends on its reading)")
         n = system.n
         self.theta = as_nonnegative("theta", theta)
+        self.on_violation = as_choice("on_violation", on_violation, EXTENDED_ON_VIOLATION)
         self.L = np.eye(n) if L is None else as_matrix("L", L, (None, n))
         l = self.L.shape[0]
         self.S = np.eye(l) if S is None else as_covariance("S", S, l, definite=False)
@@ -298,11 +307,18 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
         N = np.eye(P.shape[-1]) + Ct @ G @ C
         N = 0.5 * (N + np.swapaxes(N, -1, -2))
         margin = np.linalg.eigvalsh(N)[..., 0]
-        if not np.all(margin > 0):
-            raise InputError(
-                f"filter {self.name!r}: theta = {self.theta:g} violates the existence condition "
-                f"P_k^-1 - theta*S̄ + H_k^T R^-1 H_k > 0 (smallest eigenvalue of N: {np.min(margin):.3g}); choose a "
-                "smaller theta or a smaller P0")
+        ok = margin > 0
+        if not np.all(ok):
+            if self.on_violation == "raise":
+                raise InputError(
+                    f"filter {self.name!r}: theta = {self.theta:g} violates the existence condition "
+                    f"P_k^-1 - theta*S̄ + H_k^T R^-1 H_k > 0 (smallest eigenvalue of N: {np.min(margin):.3g}); "
+                    "choose a smaller theta or a smaller P0, or on_violation='kalman'")
+            # "kalman": θ = 0 at this step on the runs that violate it (N = I + Cᵀ HᵀR⁻¹H C > 0 always)
+            theta = self.theta * np.asarray(ok, dtype=float)[..., None, None]
+            G = HtRi @ H - theta * self.Sbar
+            N = np.eye(P.shape[-1]) + Ct @ (0.5 * (G + np.swapaxes(G, -1, -2))) @ C
+            N = 0.5 * (N + np.swapaxes(N, -1, -2))
         Y = np.linalg.solve(np.linalg.cholesky(N), Ct)  # N_c⁻¹ Cᵀ
         P_post = np.swapaxes(Y, -1, -2) @ Y  # C N⁻¹ Cᵀ = P̄
         gain = P_post @ HtRi
@@ -310,5 +326,6 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
         dx = innovation @ gain.T if gain.ndim == 2 else (gain @ innovation[..., None])[..., 0]
         Sk = H @ P @ np.swapaxes(H, -1, -2) + R
         diag = {"innovation_covariance": Sk if Sk.ndim == 3 else np.broadcast_to(Sk, (runs,) + Sk.shape),
-                "existence_margin": np.broadcast_to(margin, (runs,)).copy()}
+                "existence_margin": np.broadcast_to(margin, (runs,)).copy(),
+                "existence_ok": np.broadcast_to(ok, (runs,)).copy()}
         return dx, P_post, diag
