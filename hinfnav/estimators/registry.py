@@ -166,7 +166,8 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     fits : callable, optional
         ``fits(scenario) -> bool``, for scenarios that declare no :class:`Offers`
         (and checked too on those that do); default: fits every scenario. It may
-        return a string instead of False: the reason it does not fit.
+        return a string instead of False: the reason it does not fit (a string is
+        truthy: ask :func:`fit_reason`, not ``fits`` itself).
     description : str
     requires : Requires, optional
         What the estimator needs, checked against a scenario's ``offers`` (:func:`fit_reason`).

@@ -93,7 +93,7 @@ def benchmark_campaign(*, runs=200, seed=0, estimators=None, batch_size=200, man
 #: s; ``steady`` is the table's), ``quantities`` (the two state groups of the table), ``tol`` (convergence
 #: tolerance per component, or None), optionally ``same_as`` (estimator → the estimator whose estimates it repeats
 #: bit for bit on that scenario: not run, listed with :func:`non_fitting`'s reasons; the generic filters of Sun's
-#: declared Kalman model are Sun's own Kalman-type filters, checked in ``tests/test_benchmark_linear_designs.py``).
+#: declared Kalman model are Sun's own Kalman-type and thrust-adaptive filters, checked in ``tests/test_benchmark_linear_designs.py``).
 #: Sized so that the whole benchmark takes at most 5 minutes on 2 cores (measured in the README); the scenarios'
 #: own defaults are the papers' (longer runs).
 SCENARIOS = {
@@ -101,7 +101,7 @@ SCENARIOS = {
                 "windows": {"early": (0.0, 500.0), "steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"),
                 "tol": TOL,
                 "same_as": {"model_ekf": "ekf_known_input", "model_ukf": "ukf", "model_hbf": "hbf",
-                            "model_stekf": "stekf"}},
+                            "model_stekf": "stekf", "model_adaptive": "ekf_augmented_thrust_adaptive"}},
     "shi2018": {"grid": {"maneuver": [True, False], "noise": ["gaussian", "mixture"]},
                 "windows": {"steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"), "tol": None},
     "attitude2018": {"grid": {"orbits": [0.5], "T0": [1e-5, 1e-4], "noise": ["gaussian"]},
