@@ -33,6 +33,22 @@ correction to the *un-propagated* state, which ``predict`` then multiplies by
 F again: its estimate after update and predict is ``F x̂ + F² K (y − H x̂)``
 instead of ``F x̂ + F K (y − H x̂)``. With F = I the two coincide
 (``tests/test_recursive_hinf.py`` checks both statements).
+
+The *extended* H∞ filter (:class:`ExtendedHInfinityFilter`) is the same
+recursion with a nonlinear measurement linearized at the prior estimate, as
+the EKF does: with ``H_k = ∂h/∂x(x̂_k)`` and ``P̄_k = (P_k⁻¹ − θS̄ + H_kᵀR⁻¹H_k)⁻¹``,
+Simon's gain is ``K_k = P̄_k H_kᵀ R⁻¹``, so
+
+.. code-block:: text
+
+    x̄_k     = x̂_k + P̄_k H_kᵀ R⁻¹ (y_k − h(x̂_k))                      (X1)
+    x̂_{k+1} = Φ x̄_k + Γ u_k,      P_{k+1} = Φ P̄_k Φᵀ + Q              (X2)
+
+which is the Kalman core's step (:class:`~hinfnav.estimators.ExtendedKalmanFilter`)
+with the correction (X1) in place of the Joseph update; with a linear
+measurement it is the filter above step for step, with θ = 0 the EKF.
+P then depends on the data (H_k at each run's estimate): every run carries
+its own, and the existence condition ``N_k > 0`` is checked per run.
 """
 
 from __future__ import annotations
@@ -47,6 +63,7 @@ from ..core.exceptions import HinfnavError, InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_matrix, as_nonnegative
 from .base import Estimator, FilterState, StepOutput
+from .kalman import ExtendedKalmanFilter
 from .steady import freeze_gain
 
 if TYPE_CHECKING:
@@ -54,10 +71,14 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["RecursiveHInfinityFilter", "ON_VIOLATION", "STEADY_TOL"]
+__all__ = ["RecursiveHInfinityFilter", "ExtendedHInfinityFilter", "ON_VIOLATION", "EXTENDED_ON_VIOLATION",
+           "STEADY_TOL"]
 
 #: What the filter does when the existence condition fails.
 ON_VIOLATION = ("raise", "flag")
+
+#: What the extended filter does where the existence condition fails for a run: raise, or use θ = 0 at that step.
+EXTENDED_ON_VIOLATION = ("raise", "kalman")
 
 #: Default ``steady_tol``: relative change of P per step (Frobenius) below which the steady gain is kept.
 STEADY_TOL = 1e-14
@@ -225,3 +246,86 @@ class RecursiveHInfinityFilter(Estimator):
             x = x + np.asarray(u, dtype=float) @ self.Gamma.T
         extra = {"steady": state.extra.get("steady")}
         return FilterState(x=x, P=state.extra["P_next"], k=state.k + 1, extra=extra)
+
+
+class ExtendedHInfinityFilter(ExtendedKalmanFilter):
+    """Simon's a-priori H∞ filter with the measurement linearized at the prior estimate (module notes, (X1)–(X2)).
+
+    Parameters
+    ----------
+    system, measurement, P0, Q, R, uses_input, name, missing
+        As :class:`~hinfnav.estimators.ExtendedKalmanFilter` (any measurement model with a Jacobian).
+    theta : float
+        Performance bound θ ≥ 0 (0: the EKF), 1 / (units of z)².
+    L, S : array_like, optional
+        As :class:`RecursiveHInfinityFilter` (default I): S̄ = Lᵀ S L.
+    output : {"predicted", "filtered"}
+        What ``update`` reports: the a-priori estimate x̂_k of Simon's filter (default) or x̄_k of (X1).
+    on_violation : {"raise", "kalman"}
+        Where the existence condition fails for a run: stop with an InputError naming θ (default), or take that
+        run's step with θ = 0 (the EKF's update; documented fallback: the game has no saddle point there), which
+        ``existence_ok`` reports.
+
+    Notes
+    -----
+    The existence condition ``P_k⁻¹ − θS̄ + H_kᵀR⁻¹H_k > 0`` is checked at every
+    step for every run (``N = I + Cᵀ(H_kᵀR⁻¹H_k − θS̄)C > 0``, ``P_k = C Cᵀ``).
+    With a linearized measurement it depends on the data, so a θ admissible
+    at the initial geometry can fail in a run's transient. Diagnostics of
+    ``update``: ``innovation``, ``innovation_covariance`` (``H_k P_k H_kᵀ + R``),
+    ``existence_margin`` (runs,), the smallest eigenvalue of N, and ``existence_ok``.
+    """
+
+    name = "extended_hinf"
+    symmetric_posterior = True
+
+    def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, theta: float,
+                 P0: ArrayLike, Q: ArrayLike | None = None, R: ArrayLike | None = None, L: ArrayLike | None = None,
+                 S: ArrayLike | None = None, uses_input: bool = True, output: str = "predicted",
+                 on_violation: str = "raise", name: str | None = None, missing: str = "refuse") -> None:
+        super().__init__(system, measurement, P0=P0, Q=Q, R=R, uses_input=uses_input, output=output, name=name,
+                         missing=missing)
+        if self.R is None:
+            raise InputError(f"filter {self.name!r} needs a constant R (give R; the measurement's covariance "
+                             "depends on its reading)")
+        n = system.n
+        self.theta = as_nonnegative("theta", theta)
+        self.on_violation = as_choice("on_violation", on_violation, EXTENDED_ON_VIOLATION)
+        self.L = np.eye(n) if L is None else as_matrix("L", L, (None, n))
+        l = self.L.shape[0]
+        self.S = np.eye(l) if S is None else as_covariance("S", S, l, definite=False)
+        Sbar = self.L.T @ self.S @ self.L
+        self.Sbar = 0.5 * (Sbar + Sbar.T)
+
+    def correct_error(self, P, H, R, innovation):
+        """(X1): ``(δx, P̄, diagnostics)`` batched (P, H, R shared or per run)."""
+        HtRi = np.swapaxes(np.linalg.solve(R, H), -1, -2)  # Hᵀ R⁻¹, (…, n, m)
+        G = HtRi @ H - self.theta * self.Sbar
+        G = 0.5 * (G + np.swapaxes(G, -1, -2))
+        C = np.linalg.cholesky(P)
+        Ct = np.swapaxes(C, -1, -2)
+        N = np.eye(P.shape[-1]) + Ct @ G @ C
+        N = 0.5 * (N + np.swapaxes(N, -1, -2))
+        margin = np.linalg.eigvalsh(N)[..., 0]
+        ok = margin > 0
+        if not np.all(ok):
+            if self.on_violation == "raise":
+                raise InputError(
+                    f"filter {self.name!r}: theta = {self.theta:g} violates the existence condition "
+                    f"P_k^-1 - theta*S̄ + H_k^T R^-1 H_k > 0 (smallest eigenvalue of N: {np.min(margin):.3g}); "
+                    "choose a smaller theta or a smaller P0, or on_violation='kalman'")
+            # "kalman": θ = 0 at this step on the runs that violate it (N = I + Cᵀ HᵀR⁻¹H C > 0 always)
+            theta = self.theta * np.asarray(ok, dtype=float)[..., None, None]
+            G = HtRi @ H - theta * self.Sbar
+            N = np.eye(P.shape[-1]) + Ct @ (0.5 * (G + np.swapaxes(G, -1, -2))) @ C
+            N = 0.5 * (N + np.swapaxes(N, -1, -2))
+        Y = np.linalg.solve(np.linalg.cholesky(N), Ct)  # N_c⁻¹ Cᵀ
+        P_post = np.swapaxes(Y, -1, -2) @ Y  # C N⁻¹ Cᵀ = P̄
+        gain = P_post @ HtRi
+        runs = innovation.shape[0]
+        dx = innovation @ gain.T if gain.ndim == 2 else (gain @ innovation[..., None])[..., 0]
+        Sk = H @ P @ np.swapaxes(H, -1, -2) + R
+        diag = {"innovation_covariance": Sk if Sk.ndim == 3 else np.broadcast_to(Sk, (runs,) + Sk.shape),
+                "existence_margin": np.broadcast_to(margin, (runs,)).copy(),
+                "existence_ok": np.broadcast_to(ok, (runs,)).copy()}
+        return dx, P_post, diag

@@ -165,7 +165,9 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     builder : callable
     fits : callable, optional
         ``fits(scenario) -> bool``, for scenarios that declare no :class:`Offers`
-        (and checked too on those that do); default: fits every scenario.
+        (and checked too on those that do); default: fits every scenario. It may
+        return a string instead of False: the reason it does not fit (a string is
+        truthy: ask :func:`fit_reason`, not ``fits`` itself).
     description : str
     requires : Requires, optional
         What the estimator needs, checked against a scenario's ``offers`` (:func:`fit_reason`).
@@ -194,7 +196,10 @@ def fit_reason(scenario: Any, name: str) -> str | None:
         why = entry.requires.reason(offers)
         if why is not None:
             return why
-    if not entry.fits(scenario):
+    fits = entry.fits(scenario)
+    if isinstance(fits, str):  # the builder's own reason
+        return fits
+    if not fits:
         return f"its builder does not take a {type(scenario).__name__} (fits() is False)"
     return None
 

@@ -29,6 +29,7 @@ from .grid import (
     scenario_campaign,
 )
 from . import estimators as _estimators  # noqa: F401  (registers the generic filters)
+from . import linear_designs as _linear_designs  # noqa: F401  (registers model_hinf, model_lmi)
 from .limits import cell_bound, cell_kalman_limit
 from .reproduce import reproduce
 from .table import QUANTITIES, benchmark_table, best_by_condition, format_markdown, plot_heatmap

@@ -91,12 +91,17 @@ def benchmark_campaign(*, runs=200, seed=0, estimators=None, batch_size=200, man
 
 #: The benchmark's grid per scenario: ``grid`` (conditions, settings and noises), ``windows`` (name → (start, end),
 #: s; ``steady`` is the table's), ``quantities`` (the two state groups of the table), ``tol`` (convergence
-#: tolerance per component, or None). Sized so that the whole benchmark takes at most 5 minutes on 2 cores
-#: (measured in the README); the scenarios' own defaults are the papers' (longer runs).
+#: tolerance per component, or None), optionally ``same_as`` (estimator → the estimator whose estimates it repeats
+#: bit for bit on that scenario: not run, listed with :func:`non_fitting`'s reasons; the generic filters of Sun's
+#: declared Kalman model are Sun's own Kalman-type and thrust-adaptive filters, checked in ``tests/test_benchmark_linear_designs.py``).
+#: Sized so that the whole benchmark takes at most 5 minutes on 2 cores (measured in the README); the scenarios'
+#: own defaults are the papers' (longer runs).
 SCENARIOS = {
     "sun2011": {"grid": {"maneuver": [True, False], "delta": [0.0, 5.0], "noise": ["gaussian", "mixture"]},
                 "windows": {"early": (0.0, 500.0), "steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"),
-                "tol": TOL},
+                "tol": TOL,
+                "same_as": {"model_ekf": "ekf_known_input", "model_ukf": "ukf", "model_hbf": "hbf",
+                            "model_stekf": "stekf", "model_adaptive": "ekf_augmented_thrust_adaptive"}},
     "shi2018": {"grid": {"maneuver": [True, False], "noise": ["gaussian", "mixture"]},
                 "windows": {"steady": (100.0, 1000.0)}, "quantities": ("position", "velocity"), "tol": None},
     "attitude2018": {"grid": {"orbits": [0.5], "T0": [1e-5, 1e-4], "noise": ["gaussian"]},
@@ -129,17 +134,22 @@ def scenario_campaign(key, *, runs=50, seed=0, estimators=None, batch_size=50, g
     g = {**spec["grid"], **(grid or {})}
     if estimators is None:
         settings = {k: v[0] for k, v in g.items() if k in scenario_parameters(key)}
-        estimators = registered_estimators(build_scenario(key, **settings))
+        same = spec.get("same_as", {})
+        estimators = [n for n in registered_estimators(build_scenario(key, **settings)) if n not in same]
     return Campaign(name=f"benchmark_{key}", runs=runs, seed=seed, batch_size=batch_size, windows=spec["windows"],
                     tol=spec["tol"], grid={"scenario": key, "estimator": list(estimators), **g})
 
 
 def non_fitting(key, settings=None):
-    """Every registered estimator that does not fit scenario ``key`` (with ``settings``), with the reason."""
+    """Every registered estimator that does not fit scenario ``key`` (with ``settings``), with the reason; and those
+    of the scenario's ``same_as`` (:data:`SCENARIOS`), not run since they repeat another's estimates."""
     sc = build_scenario(key, **(settings or {}))
+    same = SCENARIOS.get(key, {}).get("same_as", {})
     out = {}
     for name in registered_estimators():
         why = fit_reason(sc, name)
+        if why is None and name in same:
+            why = f"not run: on this scenario it is the same filter as {same[name]!r} (identical estimates)"
         if why is not None:
             out[name] = why
     return out

@@ -34,7 +34,7 @@ from ...systems.hill import (
     uncertainty_structure,
 )
 from ...systems.uncertain import UncertainSystem
-from .constants import PAPER_K
+from .constants import DEFAULT_P0_STD, PAPER_K
 
 if TYPE_CHECKING:
     from ...systems.linear import LinearSystem
@@ -89,7 +89,8 @@ class Scenario(BaseScenario):
 
     omega0: float = 7.2722e-5
     #: What it offers the estimators (issue 18: fitting by declared requirements); a class attribute, not a setting.
-    offers = Offers(error_form="additive", measurement="position", input=True, linear=True, models=("sun2011",))
+    offers = Offers(error_form="additive", measurement="position", input=True, linear=True,
+                    models=("sun2011", "kalman"))
 
     mass: float = 1000.0
     dt: float = 0.1
@@ -213,6 +214,15 @@ class Scenario(BaseScenario):
     def measurement(self) -> LinearMeasurement:
         """The indirect position measurement (8), ``y = [I 0] x + D v``."""
         return position_measurement(self.D)
+
+    def kalman_model(self) -> dict:
+        """The generic filters' model (the benchmark's ``model_*`` filters): the truth's Hill model at δ = 0 told the
+        applied thrust, the position measurement (8), P₀ = diag(DEFAULT_P0_STD)² (the EKF's); for the adaptive
+        filter, which estimates the input (the thrust) instead of being told it, a thrust rate of at most 100 N/s
+        (the truth's largest is 93 N/s) and an initial σ of 3000 N (the order of Fig 6's largest thrust): the
+        documented scales of :mod:`hinfnav.papers.attitude2018.chaser`."""
+        return {"system": self.system(), "measurement": self.measurement, "P0": np.diag(DEFAULT_P0_STD**2),
+                "uses_input": True, "input_rate_max": 100.0, "input_std0": 3000.0}
 
     def controller(self, maneuver: bool = True, source: str = "truth") -> LinearFeedback | None:
         """The orbit-maneuver law u = K x of (3) (``source="estimate"``: u = K x̂), or None without maneuver."""
