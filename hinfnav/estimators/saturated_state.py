@@ -139,6 +139,8 @@ class SaturatedExtendedStateFilter(Estimator):
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
         self._Crow = self.C[:, None, :]  # (axes, 1, 3): H of each axis
         self._Rcol = self.Reff[:, None, None]  # (axes, 1, 1): R of each axis
+        self._AT = np.swapaxes(self.A, -1, -2)  # Aᵀ per axis (a view)
+        self._inflate = (1.0 + self.theta)[:, None, None]  # 1 + θ per axis
 
     # -- array kernels (runs, n_axes, 3) -------------------------------------------------
 
@@ -160,7 +162,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     def prior_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` per axis."""
-        return (1.0 + self.theta)[:, None, None] * (self.A @ P @ np.swapaxes(self.A, -1, -2)) + self.Qtheta
+        return self._inflate * (self.A @ P @ self._AT) + self.Qtheta
 
     def flags(self, y: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Which readings sit at a bound (never in ``ideal`` mode)."""
