@@ -210,7 +210,7 @@ class SaturatedExtendedStateFilter(Estimator):
                 below = y <= self.lower
                 lo = np.where(below, -np.inf, self.upper)
                 hi = np.where(below, self.lower, np.inf)
-                m, v = truncated_normal_moments(yhat[trunc], Sy[trunc], lo[trunc], hi[trunc])
+                m, v = truncated_normal_moments(yhat[trunc], Sy[trunc], lo[trunc], hi[trunc], check=False)
                 y_eff[trunc] = m
                 extra_var = np.zeros_like(Sy)
                 extra_var[trunc] = v
