@@ -153,7 +153,7 @@ def inv_spd(S):
     m = S.shape[-1]
     if m == 1:
         det = S[..., 0, 0]
-        if (det > 0).all() and np.isfinite(det).all():  # 1/det, as below, without the error-state switch
+        if (det > 0).all() and np.isfinite(det).all():  # the usual case, as below with adj = 1
             return 1.0 / det[..., None, None]
         adj = np.ones_like(S)
     elif m == 2:
@@ -163,11 +163,12 @@ def inv_spd(S):
         adj, det = _inv_sym3(S)
     else:
         return np.linalg.inv(S)
+    if (det > 0).all() and np.isfinite(det).all():  # the usual case: no quotient is invalid
+        return adj / det[..., None, None]
     with np.errstate(all="ignore"):
         out = adj / det[..., None, None]
-    if not (det > 0).all() or not np.isfinite(det).all():
-        bad = ~(np.isfinite(det) & (det > 0))
-        out[bad] = np.linalg.inv(S[bad])
+    bad = ~(np.isfinite(det) & (det > 0))
+    out[bad] = np.linalg.inv(S[bad])
     return out
 
 

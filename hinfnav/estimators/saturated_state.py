@@ -324,6 +324,7 @@ class FusedExtendedStateFilter(Estimator):
         if uidx.shape != (na,) or uidx.min() < 0 or uidx.max() >= alg1.n_input:
             raise InputError(f"input_indices must be {na} input indices of alg1; got {input_indices!r}")
         self.alg1, self.alg2, self.idx, self.uidx = alg1, alg2, idx, uidx
+        self._f_idx = idx[2 * na:]  # where Algorithm 2's f sits in Algorithm 1's state
         self.covariance = as_choice("fused covariance", covariance, FUSED_COVARIANCES)
         self.steady_tol = check_steady_tol(steady_tol)
         blocks = idx.reshape(3, na).T  # (axes, 3): [r_a, v_a, f_a]
@@ -346,8 +347,7 @@ class FusedExtendedStateFilter(Estimator):
     def fuse(self, x1: NDArray[np.float64], P1: NDArray[np.float64], X2: NDArray[np.float64], P2: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(38)-(43): returns the fused ``(x1, P1, X2, P2)`` (new arrays)."""
         x1, Xo = self._fuse_mean(x1, X2)
-        P1ax = P1[:, self._rr, self._cc]  # (runs, axes, 3, 3)
-        Po = P1ax.copy()
+        Po = P1[:, self._rr, self._cc]  # (runs, axes, 3, 3), a new array
         Po[..., 2, :] = P2[..., 2, :]
         if self.covariance == "symmetric":
             Po = 0.5 * (Po + np.swapaxes(Po, -1, -2))
@@ -427,7 +427,7 @@ class FusedExtendedStateFilter(Estimator):
     def _fuse_mean(self, x1, X2):
         """(38), (40), (42): r, ṙ of Algorithm 1 and f of Algorithm 2, written into both."""
         x1 = x1.copy()
-        x1[:, self.idx[2 * self.alg2.n_axes:]] = X2[:, :, 2]
+        x1[:, self._f_idx] = X2[:, :, 2]
         Xo = x1[:, self.idx].reshape(x1.shape[0], 3, -1).swapaxes(1, 2).copy()
         return x1, Xo
 
