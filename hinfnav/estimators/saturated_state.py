@@ -325,6 +325,9 @@ class FusedExtendedStateFilter(Estimator):
             raise InputError(f"input_indices must be {na} input indices of alg1; got {input_indices!r}")
         self.alg1, self.alg2, self.idx, self.uidx = alg1, alg2, idx, uidx
         self._f_idx = idx[2 * na:]  # where Algorithm 2's f sits in Algorithm 1's state
+        self._fused_rc = np.zeros((alg1.n_state, alg1.n_state), dtype=bool)  # the rows and columns (40)-(43) replace
+        self._fused_rc[idx, :] = True
+        self._fused_rc[:, idx] = True
         self.covariance = as_choice("fused covariance", covariance, FUSED_COVARIANCES)
         self.steady_tol = check_steady_tol(steady_tol)
         blocks = idx.reshape(3, na).T  # (axes, 3): [r_a, v_a, f_a]
@@ -354,9 +357,7 @@ class FusedExtendedStateFilter(Estimator):
         elif self.covariance == "block":
             Po[..., :2, 2] = 0.0
             Po[..., 2, :2] = 0.0
-        P1 = P1.copy()
-        P1[:, self.idx, :] = 0.0
-        P1[:, :, self.idx] = 0.0
+        P1 = np.where(self._fused_rc, 0.0, P1)  # a copy with the rows and columns of idx zeroed
         P1[:, self._rr, self._cc] = Po
         return x1, P1, Xo, Po
 
