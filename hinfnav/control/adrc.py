@@ -254,8 +254,8 @@ class DragFreeADRC:
         u = np.empty((runs, 9))
         u[:, 0:3] = u0[:, 0:3] @ self.I_sc.T - xhat[:, 6:9]
         if self._comp_rows is not None:  # stacked laws: compensation per row
-            u[:, 3:6] = np.where(self._comp_rows[:, None], -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18],
-                                 -u0[:, 3:6])
+            minus = -u0[:, 3:6]
+            u[:, 3:6] = np.where(self._comp_rows[:, None], minus + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18], minus)
         elif self.dragfree_compensation:
             u[:, 3:6] = -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18]
         else:

@@ -331,6 +331,7 @@ class FusedExtendedStateFilter(Estimator):
         self.covariance = as_choice("fused covariance", covariance, FUSED_COVARIANCES)
         self.steady_tol = check_steady_tol(steady_tol)
         blocks = idx.reshape(3, na).T  # (axes, 3): [r_a, v_a, f_a]
+        self._axis_idx = blocks  # Algorithm 2's [r, ṙ, f] of each axis in Algorithm 1's state
         self._rr, self._cc = blocks[:, :, None], blocks[:, None, :]
         n = alg1.n_state
         m1 = alg1.measurement.n_meas
@@ -429,8 +430,7 @@ class FusedExtendedStateFilter(Estimator):
         """(38), (40), (42): r, ṙ of Algorithm 1 and f of Algorithm 2, written into both."""
         x1 = x1.copy()
         x1[:, self._f_idx] = X2[:, :, 2]
-        Xo = x1[:, self.idx].reshape(x1.shape[0], 3, -1).swapaxes(1, 2).copy()
-        return x1, Xo
+        return x1, x1[:, self._axis_idx]  # (runs, axes, 3), a new array
 
     def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
@@ -438,7 +438,7 @@ class FusedExtendedStateFilter(Estimator):
         x1 = a1.predict_mean(state.x, u, state.k * a1.dt)  # Algorithm 1's hook (with the nominal increment (9))
         u2 = u[:, self.uidx]
         steady = state.extra["steady"]
-        extra = dict(state.extra, u_feed=np.zeros_like(u2))
+        extra = dict(state.extra, u_feed=np.zeros(u2.shape))
         if steady is not None:
             X2, _ = self.alg2.kernel_predict(state.extra["X2"], None, u2)
             P1, P2 = steady["P1_prior"], steady["P2_prior"]
