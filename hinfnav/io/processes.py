@@ -32,6 +32,8 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TextIO
 
+from threadpoolctl import threadpool_limits
+
 from ..core.exceptions import InputError
 
 __all__ = ["PrefixedLines", "one_blas_thread", "run_jobs", "check_jobs", "cpu_seconds"]
@@ -83,8 +85,6 @@ class PrefixedLines(io.TextIOBase):
 @contextlib.contextmanager
 def one_blas_thread() -> Iterator[None]:
     """Context manager: the BLAS/OpenMP libraries loaded in this process run on one thread (threadpoolctl)."""
-    from threadpoolctl import threadpool_limits
-
     with threadpool_limits(limits=1):
         yield
 
