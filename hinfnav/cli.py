@@ -199,7 +199,8 @@ def _cmd_reproduce(args):
     check_output_dir(args.out, "--out")  # before the heavy imports (reproduce checks it again, atomically)
     from .papers import reproduce
 
-    reproduce(args.paper, args.out, seed=args.seed, runs=args.runs, notebooks=args.notebooks, progress=True)
+    reproduce(args.paper, args.out, seed=args.seed, runs=args.runs, notebooks=args.notebooks, progress=True,
+              jobs=args.jobs)
 
 
 def _cmd_campaign(args):
@@ -294,6 +295,9 @@ def _parser():
     r.add_argument("--runs", type=int, default=None,
                    help="Monte Carlo runs per case (default: each paper's own, e.g. 100 for sun2011)")
     r.add_argument("--notebooks", action="store_true", help="also execute the notebooks into the folder")
+    r.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="worker processes running the papers side by side, longest first (default: one per core; "
+                        "1: one after another in this process); the numbers do not depend on it")
     r.set_defaults(func=_cmd_reproduce)
 
     c = sub.add_parser("campaign", help="run a campaign (a grid of estimators x scenarios x noises x runs, TOML) on Dask")
@@ -328,6 +332,8 @@ def main(argv=None):
         parser.error(f"--seed must be >= 0; got {args.seed}")
     if getattr(args, "workers", None) is not None and (args.workers < 1 or args.scheduler is not None):
         parser.error(f"--workers must be >= 1 and applies to the LocalCluster only (not with --scheduler); got {args.workers}")
+    if getattr(args, "jobs", None) is not None and args.jobs < 1:
+        parser.error(f"--jobs must be >= 1; got {args.jobs}")
     if getattr(args, "verbatim", False) and args.design is None:
         parser.error("--verbatim applies to --design only")
     try:

@@ -199,7 +199,8 @@ def test_reproduce_notebooks_executes_each_notebook_once(runs, selection, tmp_pa
 
     monkeypatch.setattr(nbmod, "execute_notebook", lambda path, target, timeout=900: calls.update([path]) or target)
     monkeypatch.setattr(papers, "PAPERS", {k: stand_in(k) for k in KEYS})
-    cli.main(["reproduce", "--paper", selection, "--notebooks", "--out", str(tmp_path / "out")])
+    # --jobs 1: the stand-ins and the counter live in this process (worker processes would not see them)
+    cli.main(["reproduce", "--paper", selection, "--notebooks", "--jobs", "1", "--out", str(tmp_path / "out")])
     assert calls and set(calls.values()) == {1}
     assert {p.name for p in calls} == set(per_notebook)
 

@@ -123,3 +123,18 @@ def test_narrow_interval_tends_to_uniform():
 def test_bad_inputs_raise_input_error_naming_the_parameter(args, name):
     with pytest.raises(InputError, match=rf"\b{name}\b"):
         truncated_normal_moments(*args)
+
+
+def test_unchecked_call_gives_the_checked_numbers_bitwise():
+    # Source: the checked call itself (check=False only skips the input checks, issue 21): every branch
+    # (narrow, containing the mean, one- and two-sided tails, reflected) on 1-D float arrays of one shape.
+    lo = np.array([-1.0, -INF, 0.25, 1.0, 30.0, -3.0, 2.0, -INF])
+    up = np.array([2.0, 0.5, 0.2501, INF, INF, -0.5, 2.5, -40.0])
+    mu = np.array([0.0, 1.3, 0.0, 0.0, 0.0, 0.0, 0.1, 0.0])
+    var = np.array([1.0, 0.49, 1.0, 1.0, 1.0, 4.0, 0.25, 1.0])
+    checked = truncated_normal_moments(mu, var, lo, up)
+    unchecked = truncated_normal_moments(mu, var, lo, up, check=False)
+    for a, b in zip(checked, unchecked):
+        assert a.tobytes() == b.tobytes()
+    with pytest.raises(InputError, match=r"\bvar\b"):
+        truncated_normal_moments(mu, np.zeros(8), lo, up, check=False)

@@ -96,7 +96,7 @@ def _standard_moments(a, b):
     var = np.empty_like(a)
 
     narrow = _is_narrow(a, b)
-    if np.any(narrow):
+    if narrow.any():
         an, bn = a[narrow], b[narrow]
         c = np.clip(0.0, an, bn)  # point of the interval nearest the mean
         u = (an - c)[:, None] + 0.5 * (bn - an)[:, None] * (_GL_NODES + 1.0)  # u = x - c
@@ -107,7 +107,7 @@ def _standard_moments(a, b):
         var[narrow] = (w * (u - mu_u[:, None]) ** 2).sum(axis=1) / sw
 
     inner = (a <= 0.0) & ~narrow  # interval contains the mean (b >= -a >= 0)
-    if np.any(inner):
+    if inner.any():
         ai, bi = a[inner], b[inner]
         Z = 0.5 * (erf(bi / np.sqrt(2.0)) - erf(ai / np.sqrt(2.0)))
         pa, pb = _phi(ai), _phi(bi)
@@ -119,7 +119,7 @@ def _standard_moments(a, b):
         var[inner] = (1.0 + (apa - bpb) / Z) - m * m
 
     tail = (a > 0.0) & ~narrow
-    if np.any(tail):
+    if tail.any():
         at, bt = a[tail], b[tail]
         delta = bt - at
         Ra, ta, sa = _mills_t_s(at)
@@ -136,8 +136,8 @@ def _standard_moments(a, b):
     return mean, var
 
 
-def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
-                             upper: ArrayLike) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
+def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike, upper: ArrayLike, *,
+                             check: bool = True) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
     """Mean and variance of ``N(mean, var)`` conditioned on ``[lower, upper]``.
 
     Parameters
@@ -149,6 +149,11 @@ def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
     lower, upper : array_like
         Truncation bounds, ``lower < upper``; ``lower`` may be ``-inf`` and
         ``upper`` may be ``+inf``.
+    check : bool
+        Check the inputs (the default). ``False`` is for a trusted caller
+        inside a filter step (Algorithm 2's update): the four inputs must then
+        be 1-D float arrays of one shape whose bounds are valid; only
+        ``var > 0`` is still checked. The numbers are the same either way.
 
     Returns
     -------
@@ -172,6 +177,10 @@ def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
     relative accuracy of the variance degrades, as the normalising
     probability is then a difference of nearly equal numbers.
     """
+    if not check:
+        if not (var > 0).all():
+            raise InputError(f"var must be > 0; got minimum {var.min()!r}")
+        return _moments(mean, var, lower, upper)
     arrays = {}
     for name, value in (("mean", mean), ("var", var), ("lower", lower), ("upper", upper)):
         try:
@@ -198,7 +207,14 @@ def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
         raise InputError("upper must not be -inf")
 
     shape = mu.shape
-    mu, v, lo, up = (np.ravel(x).astype(float) for x in (mu, v, lo, up))
+    out_mean, out_var = _moments(*(np.ravel(x).astype(float) for x in (mu, v, lo, up)))
+    if shape == ():
+        return float(out_mean[0]), float(out_var[0])
+    return out_mean.reshape(shape), out_var.reshape(shape)
+
+
+def _moments(mu, v, lo, up):
+    """The moments of :func:`truncated_normal_moments` for valid 1-D float arrays of one shape."""
     sd = np.sqrt(v)
     with np.errstate(invalid="ignore"):
         a = (lo - mu) / sd
@@ -215,8 +231,6 @@ def truncated_normal_moments(mean: ArrayLike, var: ArrayLike, lower: ArrayLike,
         np.where(flip, up - sd * m_std, lo + sd * m_std),
         mu + sd * np.where(flip, -m_std, m_std),
     )
-    out_mean = np.clip(out_mean, lo, up)
+    out_mean = out_mean.clip(lo, up)
     out_var = np.maximum(v_std, 0.0) * v
-    if shape == ():
-        return float(out_mean[0]), float(out_var[0])
-    return out_mean.reshape(shape), out_var.reshape(shape)
+    return out_mean, out_var

@@ -182,6 +182,7 @@ class DragFreeADRC:
         self._comp_rows = None  # per-row compensation of stacked laws (:meth:`stacked`)
         self._pos = np.r_[0:3, 9:12, 18:21]
         self._rate = np.r_[3:6, 12:15, 21:24]
+        self._pos_rate = np.r_[self._pos, self._rate]
 
     def start(self, runs: int) -> NDArray[np.float64]:
         """Zero integrators e_i of the nine channels (attitude, drag-free, relative attitude): shape (runs, 9)."""
@@ -237,25 +238,30 @@ class DragFreeADRC:
         xhat = np.asarray(xhat, dtype=float)
         if xhat.ndim != 2 or xhat.shape[1] != 27:
             raise InputError(f"xhat must have shape (runs, 27); got {xhat.shape}")
-        e_p = -xhat[:, self._pos]
+        runs = xhat.shape[0]
+        # e = [e_p, e_d (, e_i)] as one (2 or 3, runs, 9) array: e_p = −x̂ of [φ_sc, r, φ_rel], e_d = −x̂ of the rates
+        e = np.empty((3 if self._has_i else 2, runs, 9))
+        np.negative(xhat[:, self._pos_rate].reshape(runs, 2, 9).swapaxes(0, 1), out=e[:2])
+        e_p = e[0]
         e_p[:, 0:3] += attitude_ref
-        e_d = -xhat[:, self._rate]
         e_i = state + self._iscale * e_p
-        g = self._g(np.stack([e_p, e_d, e_i]) if self._has_i else np.stack([e_p, e_d]))
+        if self._has_i:
+            e[2] = e_i
+        g = self._g(e)
         u0 = self._kp * g[0] + self._kd * g[1]
         if self._has_i:
             u0 = u0 + self._ki * g[2]
-        u = np.empty((xhat.shape[0], 9))
+        u = np.empty((runs, 9))
         u[:, 0:3] = u0[:, 0:3] @ self.I_sc.T - xhat[:, 6:9]
         if self._comp_rows is not None:  # stacked laws: compensation per row
-            u[:, 3:6] = np.where(self._comp_rows[:, None], -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18],
-                                 -u0[:, 3:6])
+            minus = -u0[:, 3:6]
+            u[:, 3:6] = np.where(self._comp_rows[:, None], minus + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18], minus)
         elif self.dragfree_compensation:
             u[:, 3:6] = -u0[:, 3:6] + xhat[:, 9:15] @ self._h_idf.T - xhat[:, 15:18]
         else:
             u[:, 3:6] = -u0[:, 3:6]
         u[:, 6:9] = u0[:, 6:9] @ self.I_tm.T - xhat[:, 24:27] - xhat[:, 18:24] @ self._h_itm.T
-        return saturate(u, self.bound), u, e_i
+        return u.clip(-self.bound, self.bound), u, e_i
 
     def _g(self, e):
         if np.abs(e).max() <= self._zone:  # fal's linear zone everywhere (the settled loop): one product

@@ -10,6 +10,8 @@ posterior Cramér–Rao bound's).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
@@ -151,6 +153,8 @@ def inv_spd(S):
     m = S.shape[-1]
     if m == 1:
         det = S[..., 0, 0]
+        if (det > 0).all() and np.isfinite(det).all():  # the usual case, as below with adj = 1
+            return 1.0 / det[..., None, None]
         adj = np.ones_like(S)
     elif m == 2:
         det = S[..., 0, 0] * S[..., 1, 1] - S[..., 0, 1] * S[..., 0, 1]
@@ -159,11 +163,12 @@ def inv_spd(S):
         adj, det = _inv_sym3(S)
     else:
         return np.linalg.inv(S)
+    if (det > 0).all() and np.isfinite(det).all():  # the usual case: no quotient is invalid
+        return adj / det[..., None, None]
     with np.errstate(all="ignore"):
         out = adj / det[..., None, None]
-    if not (det > 0).all() or not np.isfinite(det).all():
-        bad = ~(np.isfinite(det) & (det > 0))
-        out[bad] = np.linalg.inv(S[bad])
+    bad = ~(np.isfinite(det) & (det > 0))
+    out[bad] = np.linalg.inv(S[bad])
     return out
 
 
@@ -221,8 +226,16 @@ def joseph_covariance(P: NDArray[np.float64], K: NDArray[np.float64], H: NDArray
     R = I (the posterior Cramér–Rao bound's). The package's one Joseph form.
     Shapes broadcast: P (..., n, n), K (..., n, m), H (..., m, n), R (..., m, m).
     """
-    I_KH = np.eye(P.shape[-1]) - matmul_shared(K, H)
-    P_post = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + matmul_shared(K, R) @ np.swapaxes(K, -1, -2)
+    I_KH = _identity(P.shape[-1]) - matmul_shared(K, H)
+    P_post = I_KH @ P @ I_KH.swapaxes(-1, -2) + matmul_shared(K, R) @ K.swapaxes(-1, -2)
     if symmetrize:
-        P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
+        P_post = 0.5 * (P_post + P_post.swapaxes(-1, -2))
     return P_post
+
+
+@functools.lru_cache(maxsize=64)
+def _identity(n):
+    """``np.eye(n)``, made once per size (read-only)."""
+    eye = np.eye(n)
+    eye.setflags(write=False)
+    return eye

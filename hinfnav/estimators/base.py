@@ -325,9 +325,9 @@ class Estimator:
             raise InputError(f"filter {self.name!r}: y at step {k} must have shape (runs, n_meas) = ({runs}, {m}); "
                              f"got {y.shape}")
         if self._missing == "skip":
-            if np.any(np.isinf(y)):
+            if np.isinf(y).any():
                 raise InputError(f"filter {self.name!r}: y at step {k} has inf entries (NaN marks a missing channel)")
-        elif not np.all(np.isfinite(y)):
+        elif not np.isfinite(y).all():
             raise InputError(f"filter {self.name!r}: y at step {k} must contain only finite numbers; it has NaN or "
                              "inf entries (build the filter with missing='skip' to skip NaN channels)")
         new, out = self._update(state, y)
@@ -373,7 +373,7 @@ class Estimator:
         if u.ndim != 2 or u.shape[0] != runs or (n_in is not None and u.shape[1] != n_in):
             want = f"({runs}, {n_in})" if n_in is not None else f"({runs}, n_input)"
             raise InputError(f"filter {self.name!r}: u at step {k} must have shape {want}; got {u.shape}")
-        if not np.all(np.isfinite(u)):
+        if not np.isfinite(u).all():
             raise InputError(f"filter {self.name!r}: u at step {k} must contain only finite numbers; it has NaN or "
                              "inf entries")
         return u

@@ -139,6 +139,8 @@ class SaturatedExtendedStateFilter(Estimator):
         self._Ccol = self.C[..., None]  # (axes, 3, 1)
         self._Crow = self.C[:, None, :]  # (axes, 1, 3): H of each axis
         self._Rcol = self.Reff[:, None, None]  # (axes, 1, 1): R of each axis
+        self._AT = np.swapaxes(self.A, -1, -2)  # Aᵀ per axis (a view)
+        self._inflate = (1.0 + self.theta)[:, None, None]  # 1 + θ per axis
 
     # -- array kernels (runs, n_axes, 3) -------------------------------------------------
 
@@ -160,7 +162,7 @@ class SaturatedExtendedStateFilter(Estimator):
 
     def prior_covariance(self, P: NDArray[np.float64]) -> NDArray[np.float64]:
         """``(1+θ) A P Aᵀ + (1+1/θ) Q₁ + Q₂`` per axis."""
-        return (1.0 + self.theta)[:, None, None] * (self.A @ P @ np.swapaxes(self.A, -1, -2)) + self.Qtheta
+        return self._inflate * (self.A @ P @ self._AT) + self.Qtheta
 
     def flags(self, y: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Which readings sit at a bound (never in ``ideal`` mode)."""
@@ -208,7 +210,7 @@ class SaturatedExtendedStateFilter(Estimator):
                 below = y <= self.lower
                 lo = np.where(below, -np.inf, self.upper)
                 hi = np.where(below, self.lower, np.inf)
-                m, v = truncated_normal_moments(yhat[trunc], Sy[trunc], lo[trunc], hi[trunc])
+                m, v = truncated_normal_moments(yhat[trunc], Sy[trunc], lo[trunc], hi[trunc], check=False)
                 y_eff[trunc] = m
                 extra_var = np.zeros_like(Sy)
                 extra_var[trunc] = v
@@ -322,9 +324,14 @@ class FusedExtendedStateFilter(Estimator):
         if uidx.shape != (na,) or uidx.min() < 0 or uidx.max() >= alg1.n_input:
             raise InputError(f"input_indices must be {na} input indices of alg1; got {input_indices!r}")
         self.alg1, self.alg2, self.idx, self.uidx = alg1, alg2, idx, uidx
+        self._f_idx = idx[2 * na:]  # where Algorithm 2's f sits in Algorithm 1's state
+        self._fused_rc = np.zeros((alg1.n_state, alg1.n_state), dtype=bool)  # the rows and columns (40)-(43) replace
+        self._fused_rc[idx, :] = True
+        self._fused_rc[:, idx] = True
         self.covariance = as_choice("fused covariance", covariance, FUSED_COVARIANCES)
         self.steady_tol = check_steady_tol(steady_tol)
         blocks = idx.reshape(3, na).T  # (axes, 3): [r_a, v_a, f_a]
+        self._axis_idx = blocks  # Algorithm 2's [r, ṙ, f] of each axis in Algorithm 1's state
         self._rr, self._cc = blocks[:, :, None], blocks[:, None, :]
         n = alg1.n_state
         m1 = alg1.measurement.n_meas
@@ -344,17 +351,14 @@ class FusedExtendedStateFilter(Estimator):
     def fuse(self, x1: NDArray[np.float64], P1: NDArray[np.float64], X2: NDArray[np.float64], P2: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(38)-(43): returns the fused ``(x1, P1, X2, P2)`` (new arrays)."""
         x1, Xo = self._fuse_mean(x1, X2)
-        P1ax = P1[:, self._rr, self._cc]  # (runs, axes, 3, 3)
-        Po = P1ax.copy()
+        Po = P1[:, self._rr, self._cc]  # (runs, axes, 3, 3), a new array
         Po[..., 2, :] = P2[..., 2, :]
         if self.covariance == "symmetric":
             Po = 0.5 * (Po + np.swapaxes(Po, -1, -2))
         elif self.covariance == "block":
             Po[..., :2, 2] = 0.0
             Po[..., 2, :2] = 0.0
-        P1 = P1.copy()
-        P1[:, self.idx, :] = 0.0
-        P1[:, :, self.idx] = 0.0
+        P1 = np.where(self._fused_rc, 0.0, P1)  # a copy with the rows and columns of idx zeroed
         P1[:, self._rr, self._cc] = Po
         return x1, P1, Xo, Po
 
@@ -425,9 +429,8 @@ class FusedExtendedStateFilter(Estimator):
     def _fuse_mean(self, x1, X2):
         """(38), (40), (42): r, ṙ of Algorithm 1 and f of Algorithm 2, written into both."""
         x1 = x1.copy()
-        x1[:, self.idx[2 * self.alg2.n_axes:]] = X2[:, :, 2]
-        Xo = x1[:, self.idx].reshape(x1.shape[0], 3, -1).swapaxes(1, 2).copy()
-        return x1, Xo
+        x1[:, self._f_idx] = X2[:, :, 2]
+        return x1, x1[:, self._axis_idx]  # (runs, axes, 3), a new array
 
     def _predict(self, state, u):
         u = np.asarray(u, dtype=float)
@@ -435,7 +438,7 @@ class FusedExtendedStateFilter(Estimator):
         x1 = a1.predict_mean(state.x, u, state.k * a1.dt)  # Algorithm 1's hook (with the nominal increment (9))
         u2 = u[:, self.uidx]
         steady = state.extra["steady"]
-        extra = dict(state.extra, u_feed=np.zeros_like(u2))
+        extra = dict(state.extra, u_feed=np.zeros(u2.shape))
         if steady is not None:
             X2, _ = self.alg2.kernel_predict(state.extra["X2"], None, u2)
             P1, P2 = steady["P1_prior"], steady["P2_prior"]
