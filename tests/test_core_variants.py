@@ -355,7 +355,9 @@ def test_one_joseph_form_and_one_gain_freeze_in_the_package():
     import hinfnav
 
     root = Path(hinfnav.__file__).parent
-    joseph = re.compile(r"eye\([^)]*\)\s*-\s*(?:matmul_shared\(\s*)?K\w*\s*[,@]|K\w*\s*@\s*R\w*\s*@\s*K\w*\.T")
+    # (I − K H) with an identity from np.eye or a cached one; K R Kᵀ as a product chain or through matmul_shared
+    joseph = re.compile(r"(?:eye|identity)\([^)]*\)\s*-\s*(?:matmul_shared\(\s*)?K\w*\s*[,@]"
+                        r"|K\w*\s*@\s*R\w*\s*@\s*K\w*\.T|matmul_shared\(\s*K\w*\s*,\s*R\w*\s*\)\s*@\s*K\w*")
     freeze = re.compile(r"def\s+\w*(?:freeze|frozen|converged)\w*\s*\(")
     found = {"joseph": set(), "freeze": set()}
     for path in root.rglob("*.py"):

@@ -171,10 +171,12 @@ def test_refuse_is_the_default_and_inf_is_never_missing():
 
 _SCENARIOS = (SunScenario(duration_s=30.0, rms_window_s=(5.0, 30.0)), ShiScenario(), AttitudeScenario())
 _YANG = YangScenario(n_steps=50)
-#: fixed gains (the predicted reading fills the gap, tested below) and the rate-adaptive noise (its rate
-#: window takes the estimate of every step, updated or not: documented)
+#: fixed gains (the predicted reading fills the gap, tested below), the a-priori recursive H∞ filters (their gain
+#: uses y_k: predict needs an update first) and the rate-adaptive noise (its rate window takes the estimate of every
+#: step, updated or not: documented; ``model_adaptive`` is built on Sun's chaser, where it is that filter)
 _NOT_PREDICT_ONLY = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
-                     "designed_observer_closed_loop", "recursive_hinf", "aaekf", "ekf_augmented_thrust_adaptive")
+                     "designed_observer_closed_loop", "recursive_hinf", "model_hinf", "aaekf",
+                     "ekf_augmented_thrust_adaptive", "model_adaptive")
 _CHEAP = [n for n in registered_estimators() if n not in _NOT_PREDICT_ONLY]
 
 
