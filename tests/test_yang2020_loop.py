@@ -105,3 +105,21 @@ def test_batched_variants_equal_their_own_loops(loop):
         run_closed_loops([(SC, "adrc"), (replace(SC, timing="prior"), "adrc")])
     with pytest.raises(InputError, match="first variant's readings"):
         run_closed_loops([(SC, "adrc"), (sc_n, "adrc")], passive=(False, True))
+
+
+def test_a_loop_that_goes_non_finite_is_refused(monkeypatch):
+    # the loop calls the filters' hooks (no per-step input checks): a NaN state must still end in an InputError,
+    # checked once after the loop, not a silently NaN result
+    from hinfnav.papers.yang2020 import loop
+
+    step = loop._Plant.step
+
+    def nan_step(self, k, x, u):
+        out = step(self, k, x, u)
+        if k == 50:
+            out[:, 6] = np.nan
+        return out
+
+    monkeypatch.setattr(loop._Plant, "step", nan_step)
+    with pytest.raises(InputError, match="non-finite"):
+        run_closed_loop(replace(SC, n_steps=100), passive=True)

@@ -371,7 +371,10 @@ class FusedExtendedStateFilter(Estimator):
 
     def feed_input(self, state: FilterState, u: ArrayLike) -> FilterState:
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
-        u = self._check_feed_input(state, u)
+        return self._feed_input(state, self._check_feed_input(state, u))
+
+    def _feed_input(self, state: FilterState, u: NDArray[np.float64]) -> FilterState:
+        """:meth:`feed_input`'s hook, ``u`` already checked (a loop that checked its inputs once calls it)."""
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
                            phase=state.phase)
 
