@@ -190,7 +190,12 @@ def range_angles(x: ArrayLike, C_bl: ArrayLike | None = None) -> NDArray[np.floa
     ndarray, shape (..., 3)
         ρ (m), α (rad, in (−π, π]), β (rad, in [−π/2, π/2]).
     """
-    p = _positions(x) @ _check_C_bl(C_bl).T
+    return _range_angles(x, _check_C_bl(C_bl))
+
+
+def _range_angles(x, C):
+    """:func:`range_angles` with ``C`` already checked by :func:`_check_C_bl`."""
+    p = _positions(x) @ C.T
     rho = np.linalg.norm(p, axis=-1)
     if np.any(rho == 0):
         raise InputError("x has a zero relative position; range and angles are undefined there")
@@ -219,7 +224,11 @@ def range_angles_jacobian(x: ArrayLike, C_bl: ArrayLike | None = None, n_state: 
         On the line of sight's singularities (zero range, or the position on
         the sensor z axis where the azimuth is undefined).
     """
-    C = _check_C_bl(C_bl)
+    return _range_angles_jacobian(x, _check_C_bl(C_bl), n_state)
+
+
+def _range_angles_jacobian(x, C, n_state):
+    """:func:`range_angles_jacobian` with ``C`` already checked by :func:`_check_C_bl`."""
     x = np.asarray(x, dtype=float)
     n = x.shape[-1] if n_state is None else int(n_state)
     p = _positions(x) @ C.T
@@ -286,17 +295,24 @@ class RangeAzimuthElevation(MeasurementModel):
         n_state = as_int_at_least("n_state", n_state, 3)  # the first three components are the position
         self.sigma_range = as_positive("sigma_range", sigma_range)
         self.sigma_angle = as_positive("sigma_angle", sigma_angle)
-        self.C_bl = _check_C_bl(C_bl)
+        self.C_bl = _check_C_bl(C_bl).copy()
+        self.C_bl.setflags(write=False)  # checked once here (read-only), not at every call
+        self._C_checked = self.C_bl
         super().__init__(
             n_state, np.diag([self.sigma_range, self.sigma_angle, self.sigma_angle]),
             ("range", "azimuth", "elevation"), ("m", "rad", "rad"),
         )
 
     def function(self, x: ArrayLike) -> NDArray[np.float64]:
-        return range_angles(self.check_state(x), self.C_bl)
+        return _range_angles(self.check_state(x), self._rotation())
 
     def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
-        return range_angles_jacobian(self.check_state(x), self.C_bl, self.n_state)
+        return _range_angles_jacobian(self.check_state(x), self._rotation(), self.n_state)
+
+    def _rotation(self):
+        """C_bl, checked again only if it was replaced since the constructor checked it."""
+        C = self.C_bl
+        return C if C is self._C_checked else _check_C_bl(C)
 
     def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(y, dtype=float) - np.asarray(yhat, dtype=float)
