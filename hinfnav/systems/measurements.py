@@ -264,6 +264,11 @@ def position_from_range_angles(m: ArrayLike, C_bl: ArrayLike | None = None) -> N
     ndarray, shape (..., 3)
         ``C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)``, m.
     """
+    m = _check_range_angles(m)
+    return _position_from_range_angles(m, _check_C_bl(C_bl))
+
+
+def _check_range_angles(m):
     m = np.asarray(m, dtype=float)
     if m.ndim < 1 or m.shape[-1] != 3:
         raise InputError(f"m must have shape (..., 3) (range, azimuth, elevation); got {m.shape}")
@@ -271,9 +276,14 @@ def position_from_range_angles(m: ArrayLike, C_bl: ArrayLike | None = None) -> N
         raise InputError("m must contain only finite numbers; it has NaN or inf entries")
     if np.any(m[..., 0] < 0):
         raise InputError(f"m: the range (first entry) must be >= 0 m; its smallest is {m[..., 0].min():g}")
+    return m
+
+
+def _position_from_range_angles(m, C):
+    """:func:`position_from_range_angles` of checked readings ``m`` with ``C`` checked by :func:`_check_C_bl`."""
     rho, a, b = m[..., 0], m[..., 1], m[..., 2]
     pb = np.stack([rho * np.cos(b) * np.cos(a), rho * np.cos(b) * np.sin(a), -rho * np.sin(b)], axis=-1)
-    return pb @ _check_C_bl(C_bl)  # C_bl⁻¹ = C_blᵀ, applied to row vectors
+    return pb @ C  # C_bl⁻¹ = C_blᵀ, applied to row vectors
 
 
 class RangeAzimuthElevation(MeasurementModel):
@@ -327,7 +337,7 @@ class RangeAzimuthElevation(MeasurementModel):
 
     def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """The indirect position measurement: position (m) from (ρ, α, β), eq. (7)."""
-        return position_from_range_angles(m, self.C_bl)
+        return _position_from_range_angles(_check_range_angles(m), self._rotation())
 
     def position_covariance(self, m: ArrayLike) -> NDArray[np.float64]:
         """Covariance ``J R Jᵀ`` of the converted position at (ρ, α, β) (first order), shape (..., 3, 3)."""
@@ -335,9 +345,9 @@ class RangeAzimuthElevation(MeasurementModel):
         rho, a, b = m[..., 0], m[..., 1], m[..., 2]
         J = np.zeros(m.shape[:-1] + (3, 3))
         ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
-        J[..., 0, :] = np.stack([cb * ca, -rho * cb * sa, -rho * sb * ca], axis=-1)
-        J[..., 1, :] = np.stack([cb * sa, rho * cb * ca, -rho * sb * sa], axis=-1)
-        J[..., 2, :] = np.stack([-sb, np.zeros_like(rho), -rho * cb], axis=-1)
+        J[..., 0, 0], J[..., 0, 1], J[..., 0, 2] = cb * ca, -rho * cb * sa, -rho * sb * ca
+        J[..., 1, 0], J[..., 1, 1], J[..., 1, 2] = cb * sa, rho * cb * ca, -rho * sb * sa
+        J[..., 2, 0], J[..., 2, 2] = -sb, -rho * cb  # J[..., 2, 1] = 0
         Jl = self.C_bl.T @ J
         return Jl @ self.R @ np.swapaxes(Jl, -1, -2)
 
