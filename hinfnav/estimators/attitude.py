@@ -86,7 +86,8 @@ class AttitudeAEKF(AugmentedEKF):
         return self.system.transition(x)
 
     def observe(self, x):
-        return self.measurement.function(x), self.measurement.error_jacobian(x)
+        b = self.measurement.function(x)  # h(x̂) once: the Jacobian's blocks are [b̂_i×]
+        return b, self.measurement.error_jacobian_at(b)
 
     def inject(self, x, dx):
         return self.system.inject(x, dx)

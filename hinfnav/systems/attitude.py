@@ -521,7 +521,10 @@ class StarSensorVectors(MeasurementModel):
 
     def error_jacobian(self, x):
         """``∂h/∂(δθ, δω, δT)`` at a batch of estimates: blocks ``[b̂_i×]``, shape (..., 3k, 9)."""
-        b = self.function(x)
+        return self.error_jacobian_at(self.function(x))
+
+    def error_jacobian_at(self, b):
+        """:meth:`error_jacobian` from the predicted reading ``b = h(x̂)`` (..., 3k) already computed."""
         m = b.shape[-1]
         out = np.zeros(b.shape[:-1] + (m, 9))
         out[..., :, :3] = _rows(b, self._hmap).reshape(b.shape[:-1] + (m, 3))

@@ -190,7 +190,12 @@ def range_angles(x: ArrayLike, C_bl: ArrayLike | None = None) -> NDArray[np.floa
     ndarray, shape (..., 3)
         ρ (m), α (rad, in (−π, π]), β (rad, in [−π/2, π/2]).
     """
-    p = _positions(x) @ _check_C_bl(C_bl).T
+    return _range_angles(x, _check_C_bl(C_bl))
+
+
+def _range_angles(x, C):
+    """:func:`range_angles` with ``C`` already checked by :func:`_check_C_bl`."""
+    p = _positions(x) @ C.T
     rho = np.linalg.norm(p, axis=-1)
     if np.any(rho == 0):
         raise InputError("x has a zero relative position; range and angles are undefined there")
@@ -219,7 +224,11 @@ def range_angles_jacobian(x: ArrayLike, C_bl: ArrayLike | None = None, n_state: 
         On the line of sight's singularities (zero range, or the position on
         the sensor z axis where the azimuth is undefined).
     """
-    C = _check_C_bl(C_bl)
+    return _range_angles_jacobian(x, _check_C_bl(C_bl), n_state)
+
+
+def _range_angles_jacobian(x, C, n_state):
+    """:func:`range_angles_jacobian` with ``C`` already checked by :func:`_check_C_bl`."""
     x = np.asarray(x, dtype=float)
     n = x.shape[-1] if n_state is None else int(n_state)
     p = _positions(x) @ C.T
@@ -255,6 +264,11 @@ def position_from_range_angles(m: ArrayLike, C_bl: ArrayLike | None = None) -> N
     ndarray, shape (..., 3)
         ``C_bl⁻¹ (ρ cos β cos α, ρ cos β sin α, −ρ sin β)``, m.
     """
+    m = _check_range_angles(m)
+    return _position_from_range_angles(m, _check_C_bl(C_bl))
+
+
+def _check_range_angles(m):
     m = np.asarray(m, dtype=float)
     if m.ndim < 1 or m.shape[-1] != 3:
         raise InputError(f"m must have shape (..., 3) (range, azimuth, elevation); got {m.shape}")
@@ -262,9 +276,14 @@ def position_from_range_angles(m: ArrayLike, C_bl: ArrayLike | None = None) -> N
         raise InputError("m must contain only finite numbers; it has NaN or inf entries")
     if np.any(m[..., 0] < 0):
         raise InputError(f"m: the range (first entry) must be >= 0 m; its smallest is {m[..., 0].min():g}")
+    return m
+
+
+def _position_from_range_angles(m, C):
+    """:func:`position_from_range_angles` of checked readings ``m`` with ``C`` checked by :func:`_check_C_bl`."""
     rho, a, b = m[..., 0], m[..., 1], m[..., 2]
     pb = np.stack([rho * np.cos(b) * np.cos(a), rho * np.cos(b) * np.sin(a), -rho * np.sin(b)], axis=-1)
-    return pb @ _check_C_bl(C_bl)  # C_bl⁻¹ = C_blᵀ, applied to row vectors
+    return pb @ C  # C_bl⁻¹ = C_blᵀ, applied to row vectors
 
 
 class RangeAzimuthElevation(MeasurementModel):
@@ -286,17 +305,24 @@ class RangeAzimuthElevation(MeasurementModel):
         n_state = as_int_at_least("n_state", n_state, 3)  # the first three components are the position
         self.sigma_range = as_positive("sigma_range", sigma_range)
         self.sigma_angle = as_positive("sigma_angle", sigma_angle)
-        self.C_bl = _check_C_bl(C_bl)
+        self.C_bl = _check_C_bl(C_bl).copy()
+        self.C_bl.setflags(write=False)  # checked once here (read-only), not at every call
+        self._C_checked = self.C_bl
         super().__init__(
             n_state, np.diag([self.sigma_range, self.sigma_angle, self.sigma_angle]),
             ("range", "azimuth", "elevation"), ("m", "rad", "rad"),
         )
 
     def function(self, x: ArrayLike) -> NDArray[np.float64]:
-        return range_angles(self.check_state(x), self.C_bl)
+        return _range_angles(self.check_state(x), self._rotation())
 
     def jacobian(self, x: ArrayLike) -> NDArray[np.float64]:
-        return range_angles_jacobian(self.check_state(x), self.C_bl, self.n_state)
+        return _range_angles_jacobian(self.check_state(x), self._rotation(), self.n_state)
+
+    def _rotation(self):
+        """C_bl, checked again only if it was replaced since the constructor checked it."""
+        C = self.C_bl
+        return C if C is self._C_checked else _check_C_bl(C)
 
     def residual(self, y: ArrayLike, yhat: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(y, dtype=float) - np.asarray(yhat, dtype=float)
@@ -311,7 +337,7 @@ class RangeAzimuthElevation(MeasurementModel):
 
     def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """The indirect position measurement: position (m) from (ρ, α, β), eq. (7)."""
-        return position_from_range_angles(m, self.C_bl)
+        return _position_from_range_angles(_check_range_angles(m), self._rotation())
 
     def position_covariance(self, m: ArrayLike) -> NDArray[np.float64]:
         """Covariance ``J R Jᵀ`` of the converted position at (ρ, α, β) (first order), shape (..., 3, 3)."""
@@ -319,9 +345,9 @@ class RangeAzimuthElevation(MeasurementModel):
         rho, a, b = m[..., 0], m[..., 1], m[..., 2]
         J = np.zeros(m.shape[:-1] + (3, 3))
         ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
-        J[..., 0, :] = np.stack([cb * ca, -rho * cb * sa, -rho * sb * ca], axis=-1)
-        J[..., 1, :] = np.stack([cb * sa, rho * cb * ca, -rho * sb * sa], axis=-1)
-        J[..., 2, :] = np.stack([-sb, np.zeros_like(rho), -rho * cb], axis=-1)
+        J[..., 0, 0], J[..., 0, 1], J[..., 0, 2] = cb * ca, -rho * cb * sa, -rho * sb * ca
+        J[..., 1, 0], J[..., 1, 1], J[..., 1, 2] = cb * sa, rho * cb * ca, -rho * sb * sa
+        J[..., 2, 0], J[..., 2, 2] = -sb, -rho * cb  # J[..., 2, 1] = 0
         Jl = self.C_bl.T @ J
         return Jl @ self.R @ np.swapaxes(Jl, -1, -2)
 
