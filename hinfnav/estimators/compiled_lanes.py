@@ -214,6 +214,21 @@ def _mat_ht(A, H, out):
 
 
 @njit(cache=True, error_model="numpy")
+def _left_product(A, X, out, L):
+    """out = A X in the first ``L`` lanes (A's zeros skipped; each sum from 0 in the order of A's columns)."""
+    for i in range(A.shape[0]):
+        for j in range(X.shape[1]):
+            for b in range(L):
+                out[i, j, b] = 0.0
+        for t in range(A.shape[1]):
+            a = A[i, t]
+            if a != 0.0:
+                for j in range(X.shape[1]):
+                    for b in range(L):
+                        out[i, j, b] += a * X[t, j, b]
+
+
+@njit(cache=True, error_model="numpy")
 def _spd_inv(S, Lm, Si, s):
     """Si = S⁻¹ in lanes by the Cholesky factor Lm (``inv_to``'s order, symmetrised); the number of runs
     whose S is not positive definite (their entries then not finite or wrong: the caller gives up)."""
@@ -269,16 +284,8 @@ def _joseph(P, H, R, nu, PHT, S, Lm, Si, K, T2, KR, T1, Pp, dx, s):
     n = P.shape[0]
     m = H.shape[0]
     _mat_ht(P, H, PHT)
-    for i in range(m):  # S = H (P Hᵀ) + R
-        for c in range(m):
-            for b in range(LANES):
-                S[i, c, b] = 0.0
-        for j in range(n):
-            h = H[i, j]
-            if h != 0.0:
-                for c in range(m):
-                    for b in range(LANES):
-                        S[i, c, b] += h * PHT[j, c, b]
+    _left_product(H, PHT, S, LANES)  # S = H (P Hᵀ) + R
+    for i in range(m):
         for c in range(m):
             for b in range(LANES):
                 S[i, c, b] += R[i, c]
@@ -473,16 +480,7 @@ def kalman_lanes(F, G, H, Qd, R, P0, x0, y, u, use_input, filtered, huber, LRi, 
                 if use_input:
                     _load(u, r0, nb, k, ub)
                 _propagate(F, G, ub, xp, x, use_input, s)
-                for i in range(n):  # T₁ = F P⁺ (F's zeros skipped)
-                    for j in range(n):
-                        for b in range(L):
-                            T2[i, j, b] = 0.0
-                    for t in range(n):
-                        f = F[i, t]
-                        if f != 0.0:
-                            for j in range(n):
-                                for b in range(L):
-                                    T2[i, j, b] += f * Pp[t, j, b]
+                _left_product(F, Pp, T2, L)  # T₁ = F P⁺
                 for i in range(n):  # Φ P⁺ Φᵀ: the upper triangle, mirrored
                     for j in range(i, n):
                         for b in range(L):
