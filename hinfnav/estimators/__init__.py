@@ -21,6 +21,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
     from .lti import LTIFilter
     from .sigma_point import SigmaPointFilter
+    from .smoothers import SmoothedHistory, filter_smoother_consistency, smooth
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
@@ -61,6 +62,9 @@ __all__ = [
     "build_estimator",
     "registered_estimators",
     "estimator_entry",
+    "smooth",
+    "SmoothedHistory",
+    "filter_smoother_consistency",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)
