@@ -56,7 +56,7 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "store_diagnostics", "MISSING", "PHASES", "available_channels"]
+           "store_diagnostics", "MISSING", "PHASES", "available_channels", "initial_estimates"]
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
@@ -220,8 +220,21 @@ def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, 
         raise InputError(f"u must have {n_input} input channels; got {u.shape[2]}")
     if not np.all(np.isfinite(u)):
         raise InputError("u (the inputs) must contain only finite numbers; it has NaN or inf entries")
-    xhat0 = as_vector("xhat0", xhat0, n_state)
+    xhat0 = initial_estimates(xhat0, n_state, y.shape[0])
     return y, u, xhat0
+
+
+def initial_estimates(xhat0: ArrayLike, n_state: int, runs: int) -> NDArray[np.float64]:
+    """``xhat0`` checked: one prior estimate (n,) for every run, or one per run (runs, n); finite floats."""
+    arr = np.asarray(xhat0, dtype=float) if not isinstance(xhat0, np.ndarray) else xhat0.astype(float, copy=False)
+    if arr.ndim == 2:
+        if arr.shape != (runs, n_state):
+            raise InputError(f"xhat0 must have shape (n,) = ({n_state},) or (runs, n) = ({runs}, {n_state}); "
+                             f"got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise InputError("xhat0 must contain only finite numbers; it has NaN or inf entries")
+        return arr
+    return as_vector("xhat0", xhat0, n_state)
 
 
 class Estimator:
@@ -292,20 +305,24 @@ class Estimator:
     # -- the step contract: checked public calls ------------------------------
 
     def start(self, xhat0: ArrayLike, P0: ArrayLike | None = None, runs: int = 1) -> FilterState:
-        """Initial filter state for ``runs`` runs, with prior estimate ``xhat0`` (shape (n,)).
+        """Initial filter state for ``runs`` runs, with prior estimate ``xhat0`` (shape (n,), or (runs, n): one per run).
 
         ``P0`` (a finite square matrix; its size is the filter's covariance
         dimension) overrides the filter's default. Raises InputError naming
         ``xhat0``, ``P0`` or ``runs``.
         """
-        xhat0 = as_vector("xhat0", xhat0, self.n_state)
         runs = as_int_at_least("runs", runs, 1)
+        xhat0 = initial_estimates(xhat0, self.n_state, runs)
         if P0 is not None:
             P0 = np.asarray(P0, dtype=float)
             if P0.ndim != 2 or P0.shape[0] != P0.shape[1]:
                 raise InputError(f"P0 must be a square matrix; got shape {P0.shape}")
             if not np.all(np.isfinite(P0)):
                 raise InputError("P0 must contain only finite numbers; it has NaN or inf entries")
+        if xhat0.ndim == 2:  # one prior per run: each row's internal state by the filter's own _start
+            state = self._start(xhat0[0], P0, runs)
+            state.x = np.concatenate([self._start(row, P0, 1).x for row in xhat0])
+            return self._phase(state, None, "prior")
         return self._phase(self._start(xhat0, P0, runs), None, "prior")
 
     def update(self, state: FilterState, y: ArrayLike) -> tuple[FilterState, StepOutput]:
@@ -419,8 +436,9 @@ class Estimator:
             Measurements y(k) at t_k.
         u : array_like, shape (runs, n_samples, n_input)
             Inputs applied over [t_k, t_{k+1}).
-        xhat0 : array_like, shape (n,)
-            Prior estimate of x(0).
+        xhat0 : array_like, shape (n,) or (runs, n)
+            Prior estimate of x(0), one for every run or one per run (the
+            NumPy path: a compiled kernel takes one).
         P0 : array_like, shape (n, n), optional
             Initial covariance (filters that carry one; their default otherwise).
         keep_covariance : bool or "diagonal"
@@ -441,7 +459,11 @@ class Estimator:
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
-        if select_backend(self, backend, keys) == "numba":
+        if xhat0.ndim == 2:  # one prior per run: the NumPy step loop
+            if backend == "numba":
+                raise InputError("backend='numba' takes one xhat0 (n,) for every run; use backend='numpy' (or "
+                                 "'auto') with one initial estimate per run")
+        elif select_backend(self, backend, keys) == "numba":
             xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
             if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says
                 return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)

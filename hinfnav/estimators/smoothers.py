@@ -64,8 +64,7 @@ from .lti import LTIFilter
 from .recursive_hinf import ExtendedHInfinityFilter, RecursiveHInfinityFilter
 from .sigma_point import SigmaPointFilter
 
-__all__ = ["FilterRecord", "SmoothedHistory", "filter_record", "rts_smooth", "smooth", "filter_smoother_consistency",
-           "initial_states"]
+__all__ = ["FilterRecord", "SmoothedHistory", "filter_record", "rts_smooth", "smooth", "filter_smoother_consistency"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,20 +168,6 @@ def _refuse(estimator: Any) -> None:
                      "SigmaPointFilter): no smoother")
 
 
-def initial_states(estimator: Estimator, xhat0: ArrayLike, runs: int) -> NDArray[np.float64]:
-    """The initial estimates of ``runs`` runs: ``xhat0`` (n,) for all, or (runs, n), one per run (checked, finite)."""
-    x = np.asarray(xhat0, dtype=float)
-    n = estimator.n_state
-    if x.ndim == 1:
-        check_estimator_inputs(np.zeros((1, 1, estimator.measurement.n_meas)), np.zeros((1, 1, 0)), x, n)
-        return np.broadcast_to(x, (runs, n)).copy()
-    if x.shape != (runs, n):
-        raise InputError(f"xhat0 must have shape (n,) = ({n},) or (runs, n) = ({runs}, {n}); got {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise InputError("xhat0 must contain only finite numbers; it has NaN or inf entries")
-    return x.copy()
-
-
 def _cross_covariance(est: Estimator, state: Any, u: NDArray[np.float64] | None) -> NDArray[np.float64]:
     """``C_k = cov(x_k, x_{k+1} | y_0…y_k)`` at the posterior ``state`` (before its prediction)."""
     if isinstance(est, SigmaPointFilter):
@@ -216,12 +201,10 @@ def filter_record(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0
         if estimator.uses_input:
             raise InputError(f"filter {estimator.name!r} uses the applied input: u is needed")
         u = np.zeros(y_arr.shape[:2] + (0,))
-    x0 = initial_states(estimator, xhat0, y_arr.shape[0])
-    y_arr, u, _ = check_estimator_inputs(y_arr, u, x0[0], estimator.n_state, estimator.measurement.n_meas,
-                                         estimator.n_input if estimator.uses_input else None, estimator.missing)
+    y_arr, u, x0 = check_estimator_inputs(y_arr, u, xhat0, estimator.n_state, estimator.measurement.n_meas,
+                                          estimator.n_input if estimator.uses_input else None, estimator.missing)
     runs, N, _ = y_arr.shape
-    state = estimator.start(x0[0], P0, runs)
-    state.x = x0 if isinstance(estimator, SigmaPointFilter) else estimator.initial_internal(x0)
+    state = estimator.start(x0, P0, runs)
     xf, Pf, xp, Pp, C = [], [], [state.x], [state.P], []
     for k in range(N):
         state, _ = estimator._update(state, y_arr[:, k])

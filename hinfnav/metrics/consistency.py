@@ -374,45 +374,81 @@ def warn_if_diverged(summary: Mapping[str, Any], name: str, stacklevel: int = 2)
                       stacklevel=stacklevel + 1)
 
 
-def consistency(result: SimulationResult, xhat0: ArrayLike | None = None,
-                windows: Mapping[str, Sequence[float]] | None = None) -> tuple[ConsistencyStatistics, dict[str, Any]]:
-    """Consistency of a :class:`~hinfnav.sim.SimulationResult` (full histories); warns when it diverged.
+def consistency(result: SimulationResult | ArrayLike, xhat0: ArrayLike | None = None,
+                windows: Mapping[str, Sequence[float]] | None = None, *, xhat: ArrayLike | None = None,
+                P: ArrayLike | None = None, t: ArrayLike | None = None, innovation: ArrayLike | None = None,
+                S: ArrayLike | None = None, state: Any = None,
+                name: str = "filter") -> tuple[ConsistencyStatistics, dict[str, Any]]:
+    """Consistency of a :class:`~hinfnav.sim.SimulationResult` (full histories), or of plain arrays; warns when it diverged.
 
     Parameters
     ----------
-    result : SimulationResult
-        With its covariance ``P`` (a kept diagonal only, ``keep_covariance="diagonal"``,
-        gives no NEES) and, for the NIS, the diagnostics :data:`NIS_KEYS`
-        (``hinfnav.simulate`` keeps them; ``simulate_nonlinear`` when asked:
-        ``keep_covariance=True, diagnostics=NIS_KEYS``).
-    xhat0 : array_like, shape (n_stored,), optional
-        The filters' initial estimate (for the initial error scale; default
+    result : SimulationResult or array_like, shape (runs, n_samples, n_stored)
+        A simulation result with its covariance ``P`` (a kept diagonal only,
+        ``keep_covariance="diagonal"``, gives no NEES) and, for the NIS, the
+        diagnostics :data:`NIS_KEYS` (``hinfnav.simulate`` keeps them;
+        ``simulate_nonlinear`` when asked: ``keep_covariance=True,
+        diagnostics=NIS_KEYS``); or the true states x, with ``xhat`` and ``P``.
+    xhat0 : array_like, shape (n_stored,) or (runs, n_stored), optional
+        The filters' initial estimate(s) (for the initial error scale; default
         ``result.xhat0``).
     windows : dict, optional
         Name → (start, end) s; default the whole run.
+    xhat, P : array_like, optional
+        With an array ``result``: the estimates (runs, n_samples, n_stored)
+        and their covariances (runs, n_samples, n, n) (or (n_samples, n, n)
+        shared; None: no NEES).
+    t : array_like, shape (n_samples,), optional
+        Sample times, s (default 0, 1, 2 …).
+    innovation, S : array_like, optional
+        Innovations (runs, n_samples, m) and their covariances, for the NIS.
+    state : StateSpec, optional
+        The state's error definition (default x − x̂).
+    name : str
+        The filter's name (arrays only).
 
     Returns
     -------
     (ConsistencyStatistics, dict)
         The statistics and their :meth:`~ConsistencyStatistics.summary`.
     """
-    t = result.t
+    if hasattr(result, "error") and hasattr(result, "xhat"):
+        if any(v is not None for v in (xhat, P, t, innovation, S, state)):
+            raise InputError("consistency: give a SimulationResult alone, or true states with xhat=, P= … (arrays)")
+        t, x, xh, P, spec = result.t, result.x, result.xhat, result.P, result.state
+        diag = result.diagnostics or {}
+        innovation, S = diag.get(NIS_KEYS[0]), diag.get(NIS_KEYS[1])
+        xhat0 = result.xhat0 if xhat0 is None else xhat0
+        name = result.settings.get("filter", "filter")
+    else:
+        x = np.asarray(result, dtype=float)
+        if xhat is None:
+            raise InputError("consistency: with the true states as an array, give the estimates xhat= (and P=)")
+        xh, spec = np.asarray(xhat, dtype=float), state
+        if x.ndim != 3 or xh.shape != x.shape:
+            raise InputError(f"consistency: the true states {x.shape} and xhat {xh.shape} must both be "
+                             "(runs, n_samples, n)")
+        t = np.arange(x.shape[1], dtype=float) if t is None else np.asarray(t, dtype=float)
+        if t.shape != (x.shape[1],):
+            raise InputError(f"consistency: t must have shape ({x.shape[1]},); got {t.shape}")
+        if P is not None:
+            P = np.asarray(P, dtype=float)
+            if P.ndim == 3 and P.shape[0] == x.shape[1] and P.shape[1] == P.shape[2]:  # one history for every run
+                P = np.broadcast_to(P, (x.shape[0],) + P.shape)
+            if P.ndim != 4 or P.shape[:2] != x.shape[:2] or P.shape[2] != P.shape[3]:
+                raise InputError(f"consistency: P must be (runs, n_samples, n, n) matching x {x.shape}; got {P.shape}")
     windows = {"all": (float(t[0]), float(t[-1]))} if windows is None else dict(windows)
-    err = result.error
-    xhat0 = result.xhat0 if xhat0 is None else xhat0
-    P = result.P
+    err = spec.error(x, xh) if spec is not None else x - xh
     if P is not None and P.ndim == 3:  # a kept diagonal only: no NEES
         P = None
     scale0 = None
     if xhat0 is not None:
-        x0 = result.x[:, 0]
-        e_prior = result.state.error(x0, np.broadcast_to(np.asarray(xhat0, dtype=float), x0.shape)) \
-            if result.state is not None else x0 - np.asarray(xhat0, dtype=float)
+        x0 = x[:, 0]
+        e_prior = spec.error(x0, np.broadcast_to(np.asarray(xhat0, dtype=float), x0.shape)) \
+            if spec is not None else x0 - np.asarray(xhat0, dtype=float)
         scale0 = initial_scale(e_prior, None if P is None else P[:, 0], err[:, 0])
-    acc = ConsistencyAccumulator(result.runs)
-    diag = result.diagnostics or {}
-    acc.add(t, err, P, diag.get(NIS_KEYS[0]), diag.get(NIS_KEYS[1]), scale0)
-    name = result.settings.get("filter", "filter")
+    acc = ConsistencyAccumulator(x.shape[0])
+    acc.add(t, err, P, innovation, S, scale0)
     stats = acc.result(name)
     summary = stats.summary(windows)
     warn_if_diverged(summary, name)

@@ -256,7 +256,7 @@ def estimate_on_truth(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P
 def closed_loop_batch(model: TruthModel, estimator: Estimator, controller: Callable[..., Any], w: np.ndarray,
                       v: np.ndarray, xhat0: ArrayLike, *, P0: ArrayLike | None = None,
                       keep_covariance: bool | str = False,
-                      diagnostics: bool | Sequence[str] = False) -> tuple[Truth, EstimateHistory]:
+                      diagnostics: bool | Sequence[str] = False, x0: ArrayLike | None = None) -> tuple[Truth, EstimateHistory]:
     """Plant, estimator and controller stepped together over the noise ``w`` (runs, n1, p), ``v`` (runs, n1, q).
 
     At each t_k the plant is measured, the estimator updates with y_k and
@@ -264,9 +264,10 @@ def closed_loop_batch(model: TruthModel, estimator: Estimator, controller: Calla
     when its ``source`` is ``"truth"``), the plant moves (``propagate`` of a
     linear system, ``step`` of a nonlinear one) and the estimator predicts with u_k:
     :func:`~hinfnav.sim.stepped.run_stepped` with a :class:`~hinfnav.sim.stepped.ModelPlant`
-    and an :class:`~hinfnav.sim.stepped.EstimatorStage`.
+    and an :class:`~hinfnav.sim.stepped.EstimatorStage`. ``x0`` (runs, n): the runs' initial true states
+    (default the model's x₀; :meth:`TruthModel.initial_states` for dispersed ones).
     """
-    plant = ModelPlant(model, w, v)
+    plant = ModelPlant(model, w, v, x0)
     stage = EstimatorStage(estimator, np.asarray(xhat0, dtype=float), P0, keep_covariance=keep_covariance,
                            diagnostics=diagnostics, n1=plant.n1)
     hist = run_stepped(plant, stage, controller)
@@ -377,7 +378,8 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
                 t0, c0 = time.perf_counter(), time.process_time()
                 try:
                     truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0,
-                                                    keep_covariance=keep_covariance, diagnostics=diagnostics)
+                                                    keep_covariance=keep_covariance, diagnostics=diagnostics,
+                                                    x0=model.initial_states(seed, n, start))
                     settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
                                     seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
                                     feedback=getattr(law, "source", "estimate"))

@@ -112,8 +112,9 @@ class ModelPlant(SteppedPlant):
     in ``y`` (rows, n1, n_meas).
     """
 
-    def __init__(self, model: Any, w: np.ndarray, v: np.ndarray) -> None:
+    def __init__(self, model: Any, w: np.ndarray, v: np.ndarray, x0: np.ndarray | None = None) -> None:
         self.model, self.w, self.v = model, w, v
+        self.x0 = model.x0 if x0 is None else np.asarray(x0, dtype=float)  # (n,) or one per row (rows, n)
         self.system, self.meas = model.system, model.measurement
         self.rows, self.n1 = w.shape[:2]
         self.n_input = self.system.n_input
@@ -124,7 +125,7 @@ class ModelPlant(SteppedPlant):
 
     def start(self) -> np.ndarray:
         x = np.empty((self.rows, self.system.n))
-        x[:] = self.model.x0
+        x[:] = self.x0
         return x
 
     def measure(self, k: int, x: np.ndarray, u_read: np.ndarray) -> np.ndarray:

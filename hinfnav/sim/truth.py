@@ -14,6 +14,17 @@ Randomness: run ``r`` draws its noise from the ``r``-th child of
 ``numpy.random.default_rng(seed).spawn(runs)``, w first then v, whole
 histories at once. The same seed gives the same numbers, whatever the batch
 size.
+
+**Dispersed initial states.** A :class:`TruthModel` with ``x0_covariance``
+P₀ draws each run's initial state ``x_r(0) = x₀ + L z_r``, ``L Lᵀ = P₀``,
+``z_r ~ N(0, I)``, from its own stream (:func:`dispersion_rngs`: the r-th
+child of a SeedSequence tagged apart from the noise streams), so that the
+noise of a run is the same with or without dispersion and the draws do not
+depend on the batch size or the workers. With ``x₀`` the filters' x̂₀ and
+P₀ their initial covariance, the initial error is N(0, P₀) as the filters
+assume, and the NEES of the first steps is a consistency measure too. Without
+``x0_covariance`` every run starts at the same x₀ (the papers' printed
+initial states).
 """
 
 from __future__ import annotations
@@ -27,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.exceptions import InputError
+from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_vector
 from ..noise import ColoredNoise, make_noise
 
@@ -34,7 +46,7 @@ if TYPE_CHECKING:
     from ..noise import NoiseModel
 
 
-__all__ = ["TruthModel", "Truth", "child_rngs", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
+__all__ = ["TruthModel", "Truth", "child_rngs", "dispersion_rngs", "DISPERSION_TAG", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,6 +67,9 @@ class TruthModel:
         Feedback on the true state (None: zero input).
     settings : dict
         The scenario's conditions, normalized (recorded in results).
+    x0_covariance : ndarray, shape (n, n), or None
+        P₀ of dispersed initial states: each run starts at x₀ + L z_r
+        (module docstring); None: every run at x₀.
     """
 
     system: object
@@ -63,6 +78,7 @@ class TruthModel:
     n_steps: int
     controller: object = None
     settings: dict = field(default_factory=dict)
+    x0_covariance: np.ndarray = None
 
     def __post_init__(self):
         if not all(hasattr(self.system, a) for a in ("n", "dt")):
@@ -73,6 +89,25 @@ class TruthModel:
         object.__setattr__(self, "n_steps", as_int_at_least("n_steps", self.n_steps, 1))
         if self.measurement.n_state != self.system.n:
             raise InputError(f"the measurement acts on {self.measurement.n_state} states, the system has {self.system.n}")
+        if self.x0_covariance is not None:
+            spec = getattr(self.system, "state", None)
+            if spec is not None and getattr(spec, "n", self.system.n) != self.system.n:
+                raise InputError("x0_covariance: this system's state has its own error coordinates (a quaternion); "
+                                 "dispersed initial states are drawn for additive states only")
+            P0 = as_covariance("x0_covariance", self.x0_covariance, self.system.n, definite=False)
+            P0.setflags(write=False)
+            object.__setattr__(self, "x0_covariance", P0)
+
+    def initial_states(self, seed: int | np.random.SeedSequence | np.random.Generator, runs: int,
+                       first_run: int = 0) -> NDArray[np.float64]:
+        """Initial true states of runs ``first_run …`` (runs, n): x₀ each, or x₀ + L z_r when dispersed."""
+        runs = as_int_at_least("runs", runs, 1)
+        if self.x0_covariance is None:
+            return np.broadcast_to(self.x0, (runs, self.x0.size)).copy()
+        lam, V = np.linalg.eigh(self.x0_covariance)
+        L = V * np.sqrt(np.clip(lam, 0.0, None))  # L Lᵀ = P₀ (semidefinite allowed)
+        z = np.stack([rng.standard_normal(self.x0.size) for rng in dispersion_rngs(seed, runs, first_run)])
+        return self.x0 + z @ L.T
 
     @property
     def time(self) -> NDArray[np.float64]:
@@ -157,6 +192,29 @@ def child_rngs(seed: int | np.random.SeedSequence | np.random.Generator, runs: i
         for r in range(first, first + runs)]
 
 
+#: Spawn-key tag of the dispersion streams: run r's initial state is drawn from child (TAG, r) of the seed.
+DISPERSION_TAG = 0x7FFFFFFF
+
+
+def dispersion_rngs(seed: int | np.random.SeedSequence | np.random.Generator, runs: int,
+                    first: int = 0) -> list[np.random.Generator]:
+    """The generators of the initial-state draws of runs ``first …``: apart from the noise streams of :func:`child_rngs`.
+
+    Run r's generator is built from ``SeedSequence(entropy, spawn_key=key + (DISPERSION_TAG, r))`` of the seed's
+    SeedSequence (a Generator's own), so it neither consumes nor shifts the noise of any run.
+    """
+    if isinstance(seed, np.random.Generator):
+        seq = seed.bit_generator.seed_seq
+        if not isinstance(seq, np.random.SeedSequence):
+            raise InputError("seed: a Generator without a SeedSequence cannot seed dispersed initial states; give an int")
+    else:
+        child_rngs(seed, 1)  # checks the seed
+        seq = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(int(seed))
+    tagged = np.random.SeedSequence(seq.entropy, spawn_key=tuple(seq.spawn_key) + (DISPERSION_TAG,),
+                                    pool_size=seq.pool_size)
+    return child_rngs(tagged, runs, first)
+
+
 def _noise_at(noise, dt, name):
     """A noise model for a system sampled at ``dt``: colored noise is built at that T, or refused at another."""
     if isinstance(noise, str) and noise == "colored" and dt is not None:
@@ -230,7 +288,7 @@ def simulate_truth(model: TruthModel, *, noise: str | NoiseModel = "gaussian", m
     rngs = child_rngs(seed, runs, first_run)
     w, v = draw_noise(w_model, v_model, rngs, n1, system.n_noise, meas.n_noise)
     x = np.empty((runs, n1, system.n))
-    x[:, 0] = model.x0
+    x[:, 0] = model.initial_states(seed, runs, first_run)
     if linear:
         K = None if ctrl is None else ctrl.K
         AclT = system.transition_matrix(K).T
