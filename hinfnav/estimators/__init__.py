@@ -22,6 +22,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .lti import LTIFilter
     from .sigma_point import SigmaPointFilter
     from .smoothers import SmoothedHistory, filter_smoother_consistency, smooth
+    from .sqrt import SquareRootEKF, SquareRootSigmaPointFilter, square_root
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
@@ -65,6 +66,9 @@ __all__ = [
     "smooth",
     "SmoothedHistory",
     "filter_smoother_consistency",
+    "SquareRootEKF",
+    "SquareRootSigmaPointFilter",
+    "square_root",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)
