@@ -23,6 +23,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .sigma_point import SigmaPointFilter
     from .smoothers import SmoothedHistory, filter_smoother_consistency, smooth
     from .sqrt import SquareRootEKF, SquareRootSigmaPointFilter, square_root
+    from .timed import estimate_timed, smooth_timed
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
@@ -69,6 +70,8 @@ __all__ = [
     "SquareRootEKF",
     "SquareRootSigmaPointFilter",
     "square_root",
+    "estimate_timed",
+    "smooth_timed",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)

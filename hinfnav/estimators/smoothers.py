@@ -50,6 +50,7 @@ the state's ⊟ map in (S2).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -186,12 +187,14 @@ def _cross_covariance(est: Estimator, state: Any, u: NDArray[np.float64] | None)
 
 
 def filter_record(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike,
-                  P0: ArrayLike | None = None) -> FilterRecord:
+                  P0: ArrayLike | None = None, *, predictor: Callable[[int], Estimator] | None = None) -> FilterRecord:
     """Run a Gaussian filter forward over (runs, N, m) readings and record what (S1)–(S3) need.
 
     ``u`` (runs, N, n_input) may be None for a filter that does not use it;
-    ``xhat0`` is (n,) or one initial estimate per run (runs, n). Raises
-    InputError for a filter with no smoother (see the module docstring).
+    ``xhat0`` is (n,) or one initial estimate per run (runs, n);
+    ``predictor(k)``, when given, is the filter that predicts from t_k to
+    t_{k+1} (a step of its own length, :mod:`hinfnav.estimators.timed`).
+    Raises InputError for a filter with no smoother (see the module docstring).
     """
     _refuse(estimator)
     y_arr = np.asarray(y, dtype=float)
@@ -211,12 +214,13 @@ def filter_record(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0
         xf.append(state.x)
         Pf.append(state.P)
         if k < N - 1:
+            step = estimator if predictor is None else predictor(k)
             try:
-                C.append(_cross_covariance(estimator, state, u[:, k]))
+                C.append(_cross_covariance(step, state, u[:, k]))
             except np.linalg.LinAlgError:
                 raise HinfnavError(f"filter {estimator.name!r}: posterior covariance at step {k} is not positive "
                                    "definite (no sigma points for the smoother)") from None
-            state = estimator._predict(state, u[:, k])
+            state = step._predict(state, u[:, k])
             xp.append(state.x)
             Pp.append(state.P)
     stack = _stacker(runs)

@@ -32,6 +32,7 @@ from .planar import ConvertedRangeBearing, RangeBearing
 from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
+from .timed import TimedReadings, TimedSystem, merge_readings, read_timed_csv
 
 __all__ = [
     "StateSpec",
@@ -65,4 +66,8 @@ __all__ = [
     "simplex_grid",
     "two_mass_spring",
     "read_system_file",
+    "TimedSystem",
+    "TimedReadings",
+    "merge_readings",
+    "read_timed_csv",
 ]
