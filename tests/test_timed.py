@@ -145,3 +145,19 @@ def test_timed_inputs_are_checked(tmp_path):
     r = read_timed_csv(iso)
     np.testing.assert_array_equal(r.t, [0.0, 10.0])
     np.testing.assert_array_equal(r.y[0, :, 0], [2.0, 1.0])
+
+
+def test_readme_irregular_time_example_runs_verbatim(capsys):
+    # README.md, "Your own system", the second code block (the first is tests/test_readme.py's)
+    import re
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Your own system", 1)[1].split("## Command line", 1)[0]
+    code = re.findall(r"```python\n(.*?)```", section, re.S)[1]
+    namespace = {}
+    exec(compile(code, "README.md", "exec"), namespace)
+    # the square-root form gives the Joseph form's numbers (1e-10 of the scale)
+    np.testing.assert_allclose(namespace["sqrt"].xhat, namespace["filt"].xhat, rtol=0, atol=1e-10 * 20)
+    out = capsys.readouterr().out
+    v_f, v_s = (float(v) for v in re.search(r"filter (\S+) smoother (\S+)", out).groups())
+    assert abs(v_s - 0.5) < abs(v_f - 0.5)  # the smoother's velocity at t = 0 is nearer the true 0.5 m/s
