@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING, Any
 
 from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
+from ..core.validation import as_choice
+from .sqrt import FORMS, square_root
 
 if TYPE_CHECKING:
     from .base import Estimator
@@ -223,12 +225,18 @@ def estimator_entry(name: str) -> _Entry:
 
 
 @scenario_moved("name", "scenario", was=str)
-def build_estimator(scenario: Any, name: str, **options: Any) -> Estimator:
-    """Build the estimator registered as ``name`` for ``scenario``."""
+def build_estimator(scenario: Any, name: str, *, form: str = "joseph", **options: Any) -> Estimator:
+    """Build the estimator registered as ``name`` for ``scenario``.
+
+    ``form="sqrt"`` gives its square-root (Cholesky-factor) form (:func:`~hinfnav.estimators.sqrt.square_root`;
+    an InputError for a filter without one).
+    """
+    form = as_choice("form", form, FORMS)
     entry = estimator_entry(name)
     why = fit_reason(scenario, name)
     if why is not None:
         fitting = ", ".join(registered_estimators(scenario))
         raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "
                          f"these do: {fitting}")
-    return entry.builder(scenario, **options)
+    est = entry.builder(scenario, **options)
+    return est if form == "joseph" else square_root(est)
