@@ -189,14 +189,14 @@ def test_square_root_refusals_and_smoothing():
     np.testing.assert_allclose(b.xhat, a.xhat, rtol=0, atol=1e-10 * np.abs(a.xhat).max())
 
 
-def test_build_estimator_form_sqrt():
+def test_build_estimator_covariance_form_sqrt():
     import hinfnav.papers  # noqa: F401  (registers the papers' estimators)
     from hinfnav.estimators import build_estimator
     from hinfnav.papers import sun2011
     scenario = sun2011.Scenario()
-    assert type(build_estimator(scenario, "ekf", form="sqrt")).__name__ == "SquareRootEKF"
+    assert type(build_estimator(scenario, "ekf", covariance_form="sqrt")).__name__ == "SquareRootEKF"
     assert type(build_estimator(scenario, "ekf")).__name__ == "ExtendedKalmanFilter"
     with pytest.raises(InputError, match="no square-root form"):
-        build_estimator(scenario, "published", form="sqrt")
-    with pytest.raises(InputError, match="form"):
-        build_estimator(scenario, "ekf", form="cholesky")
+        build_estimator(scenario, "published", covariance_form="sqrt")
+    with pytest.raises(InputError, match="covariance_form"):
+        build_estimator(scenario, "ekf", covariance_form="cholesky")

@@ -225,13 +225,14 @@ def estimator_entry(name: str) -> _Entry:
 
 
 @scenario_moved("name", "scenario", was=str)
-def build_estimator(scenario: Any, name: str, *, form: str = "joseph", **options: Any) -> Estimator:
+def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph", **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``.
 
-    ``form="sqrt"`` gives its square-root (Cholesky-factor) form (:func:`~hinfnav.estimators.sqrt.square_root`;
-    an InputError for a filter without one).
+    ``covariance_form="sqrt"`` gives its square-root (Cholesky-factor) form
+    (:func:`~hinfnav.estimators.sqrt.square_root`; an InputError for a filter without one). ``options`` go to
+    the builder (e.g. ``form="observer"`` of a designed filter).
     """
-    form = as_choice("form", form, FORMS)
+    form = as_choice("covariance_form", covariance_form, FORMS)
     entry = estimator_entry(name)
     why = fit_reason(scenario, name)
     if why is not None:
