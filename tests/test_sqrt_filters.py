@@ -187,6 +187,10 @@ def test_square_root_refusals_and_smoothing():
     kf = ExtendedKalmanFilter(system, meas, P0=P0)
     a, b = smooth(kf, y, None, np.zeros(4)), smooth(square_root(kf), y, None, np.zeros(4))
     np.testing.assert_allclose(b.xhat, a.xhat, rtol=0, atol=1e-10 * np.abs(a.xhat).max())
+    ukf = SigmaPointFilter(system, meas, P0=P0, rule="cubature")
+    c, d = smooth(ukf, y, None, np.zeros(4)), smooth(square_root(ukf), y, None, np.zeros(4))
+    np.testing.assert_allclose(d.xhat, c.xhat, rtol=0, atol=1e-10 * np.abs(c.xhat).max())
+    np.testing.assert_allclose(c.xhat, a.xhat, rtol=0, atol=1e-10 * np.abs(a.xhat).max())  # linear: URTS = RTS
 
 
 def test_build_estimator_covariance_form_sqrt():

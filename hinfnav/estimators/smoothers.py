@@ -173,7 +173,10 @@ def _cross_covariance(est: Estimator, state: Any, u: NDArray[np.float64] | None)
     """``C_k = cov(x_k, x_{k+1} | y_0…y_k)`` at the posterior ``state`` (before its prediction)."""
     if isinstance(est, SigmaPointFilter):
         runs, n = state.x.shape
-        dX = est._points(state.P, state.k, "posterior")  # the filter's own sigma points about x̂(k|k)
+        if "S" in state.extra and hasattr(est, "_offsets"):  # a square-root filter: its own factor
+            dX = est._offsets(state.extra["S"])
+        else:  # the filter's own sigma points about x̂(k|k)
+            dX = est._points(state.P, state.k, "posterior")
         N = dX.shape[1]
         uu = np.repeat(np.asarray(u, dtype=float), N, axis=0) if est.uses_input else None
         Xf = est._propagate((state.x[:, None, :] + dX).reshape(runs * N, n), uu, state.k * est.dt).reshape(runs, N, n)
