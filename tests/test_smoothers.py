@@ -197,12 +197,30 @@ def test_filter_smoother_consistency_on_a_matched_model():
 def test_hinf_and_deferred_prior_filters_are_refused_with_the_reason():
     system, meas, P0, _, y = linear_record(runs=1, N=5)
     hinf = RecursiveHInfinityFilter(system, meas, theta=1e-3, P0=P0)
-    with pytest.raises(InputError, match="H∞ filter.*not an error covariance"):
+    with pytest.raises(InputError, match="H∞ filter.*not an error covariance.*hinf_fixed_lag"):
         smooth(hinf, y, None, np.zeros(4))
     lti = LTIFilter(0.5 * np.eye(4), np.zeros((4, 2)), np.eye(4), system, meas)
-    with pytest.raises(InputError, match="H∞ fixed-lag smoother"):
+    with pytest.raises(InputError, match="fixed-gain"):
         smooth(lti, y, None, np.zeros(4))
     with pytest.raises(InputError, match="completes its prior"):
         smooth(StrongTrackingEKF(system, meas, P0=P0), y, None, np.zeros(4))
     with pytest.raises(InputError, match="lag"):
         smooth(ExtendedKalmanFilter(system, meas, P0=P0), y, None, np.zeros(4), lag=-1)
+
+
+@pytest.mark.parametrize("lag", [0, 3])
+def test_hinf_fixed_lag_at_theta_0_is_the_kalman_fixed_lag_smoother(lag):
+    from hinfnav.estimators.hinf_smoother import hinf_fixed_lag
+    system, meas, P0, x, y = linear_record(runs=2, N=30, seed=5)
+    u = np.zeros(y.shape[:2] + (1,))
+    # θ = 0: Simon's filter is the Kalman predictor, on the lag-augmented state the Kalman fixed-lag smoother
+    # (independent: the RTS-window fixed-lag smoother of this module)
+    h0 = hinf_fixed_lag(RecursiveHInfinityFilter(system, meas, theta=0.0, P0=P0), y, u, np.zeros(4), lag)
+    ref = smooth(ExtendedKalmanFilter(system, meas, P0=P0), y, None, np.zeros(4), lag=lag)
+    np.testing.assert_allclose(h0.xhat, ref.xhat, rtol=0, atol=1e-10 * np.abs(ref.xhat).max())
+    # θ > 0: a different estimate, the existence condition holding at every step of the augmented recursion
+    h1 = hinf_fixed_lag(RecursiveHInfinityFilter(system, meas, theta=0.05, P0=P0), y, u, np.zeros(4), lag)
+    assert np.all(h1.diagnostics["existence_margin"] > 0)
+    assert np.abs(h1.xhat - h0.xhat).max() > 1e-6
+    with pytest.raises(InputError, match="theta"):  # a θ beyond what the augmented recursion admits
+        hinf_fixed_lag(RecursiveHInfinityFilter(system, meas, theta=50.0, P0=P0), y, u, np.zeros(4), lag)

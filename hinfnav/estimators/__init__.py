@@ -24,6 +24,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .smoothers import SmoothedHistory, filter_smoother_consistency, smooth
     from .sqrt import SquareRootEKF, SquareRootSigmaPointFilter, square_root
     from .timed import estimate_timed, smooth_timed
+    from .hinf_smoother import hinf_fixed_lag
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
 __all__ = [
@@ -72,6 +73,7 @@ __all__ = [
     "square_root",
     "estimate_timed",
     "smooth_timed",
+    "hinf_fixed_lag",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)

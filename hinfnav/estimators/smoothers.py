@@ -34,14 +34,13 @@ each ratio ``(x̂_i(k|k) − x̂ˢ_i(k)) / √(P_ii(k|k) − Pˢ_ii(k))`` should
 standard normal; |ratio| > 3 flags a component whose filter and smoother
 disagree more than their covariances allow (:func:`filter_smoother_consistency`).
 
-**Not smoothed.** The H∞ filters (:class:`~hinfnav.estimators.LTIFilter`,
-:class:`~hinfnav.estimators.RecursiveHInfinityFilter`,
-:class:`~hinfnav.estimators.recursive_hinf.ExtendedHInfinityFilter`): their P
-(if any) is the Riccati bound of a game, not an error covariance, so (S1)–(S3)
-have no meaning for them; an H∞ fixed-lag smoother (Zhang, Xie & Soh, IEEE TAC
-50(9), 2005) is a different Riccati recursion with its own existence
-condition on γ at every lag, not built here: :func:`smooth` refuses them with
-an :class:`~hinfnav.core.exceptions.InputError` saying so. Also refused:
+**Not smoothed here.** The H∞ filters: their P (if any) is the Riccati bound
+of a game, not an error covariance, so (S1)–(S3) have no meaning for them;
+:func:`smooth` refuses them with an :class:`~hinfnav.core.exceptions.InputError`
+saying so. The H∞ fixed-lag smoother of the recursive H∞ filter is
+:func:`hinfnav.estimators.hinf_smoother.hinf_fixed_lag` (its game on the
+lag-augmented state); a fixed-gain :class:`~hinfnav.estimators.LTIFilter` has no
+such recursion, and the extended H∞ filter's is not built. Also refused:
 filters whose prior is completed at the next reading (strong tracking's
 fading factors, rate-adapted Q: ``defers_prior``) and filters on error
 coordinates (quaternion attitude, augmented states), whose smoothing needs
@@ -142,12 +141,19 @@ class SmoothedHistory:
 def _refuse(estimator: Any) -> None:
     """An InputError naming why ``estimator`` has no Gaussian smoother here (nothing when it has one)."""
     name = type(estimator).__name__
-    if isinstance(estimator, (LTIFilter, RecursiveHInfinityFilter, ExtendedHInfinityFilter)):
+    if isinstance(estimator, RecursiveHInfinityFilter):
         raise InputError(
-            f"{name} is an H∞ filter: its P (if any) is the Riccati bound of a game, not an error covariance, so the "
+            f"{name} is an H∞ filter: its P is the Riccati bound of a game, not an error covariance, so the "
             "Rauch–Tung–Striebel recursion (which needs P(k|k), P(k+1|k) and their cross-covariance) does not apply; "
-            "an H∞ fixed-lag smoother (Zhang, Xie & Soh, IEEE TAC 50(9), 2005) is a separate Riccati recursion with "
-            "its own existence condition on γ, not implemented. Smooth with the Kalman/EKF, sigma-point or Huber filter")
+            "its H∞ fixed-lag smoother is hinfnav.estimators.hinf_smoother.hinf_fixed_lag(filter, y, u, xhat0, lag)")
+    if isinstance(estimator, (LTIFilter, ExtendedHInfinityFilter)):
+        raise InputError(
+            f"{name} is an H∞ filter with no Gaussian smoother: its P (if any) is not an error covariance, so the "
+            "Rauch–Tung–Striebel recursion does not apply, and an H∞ fixed-lag smoother needs the game's Riccati "
+            "recursion on the lag-augmented state, which a fixed-gain (LMI-designed) filter does not have and the "
+            "extended (linearised, data-dependent) filter has not been given here; build a "
+            "RecursiveHInfinityFilter on the same linear model and use hinf_smoother.hinf_fixed_lag, or smooth with "
+            "the Kalman/EKF, sigma-point or Huber filter")
     if isinstance(estimator, SigmaPointFilter):
         if estimator.error_coordinates:
             raise InputError(f"{name} on a state with its own error (a quaternion) is not smoothed: (S2) needs the "
