@@ -379,7 +379,8 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
                 try:
                     truth, hist = closed_loop_batch(model, est, law, w, v, xhat0, P0=P0,
                                                     keep_covariance=keep_covariance, diagnostics=diagnostics,
-                                                    x0=model.initial_states(seed, n, start))
+                                                    x0=model.initial_states(seed, n, start)
+                                                    if hasattr(model, "initial_states") else None)
                     settings = dict(truth.settings, noise=w_model.name, measurement_noise=v_model.name,
                                     seed=seed if isinstance(seed, (int, np.integer)) else repr(seed),
                                     feedback=getattr(law, "source", "estimate"))
