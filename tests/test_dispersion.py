@@ -101,3 +101,24 @@ def test_consistency_of_arrays_equals_that_of_a_result():
     np.testing.assert_allclose(c.nees, a.nees, rtol=1e-12)
     with pytest.raises(InputError, match="xhat="):
         consistency(truth.x)
+
+
+class Dispersed:
+    """A scenario of one's own with dispersed initial states."""
+
+    xhat0 = XHAT0
+
+    def truth_model(self):
+        return TruthModel(SYSTEM, MEAS, XHAT0, 8, x0_covariance=P0)
+
+
+@pytest.mark.parametrize("closed_loop", [False, True])
+def test_engine_draws_the_same_initial_states_whatever_the_batch(closed_loop):
+    from hinfnav.sim import HistorySink, run_monte_carlo
+    kf = ExtendedKalmanFilter(SYSTEM, MEAS, P0=P0)
+    law = (lambda x: np.zeros((x.shape[0], 1))) if closed_loop else None
+    out = [run_monte_carlo(Dispersed(), {"kf": kf}, sink=HistorySink(XHAT0, 7), runs=7, seed=5, batch_size=b,
+                           closed_loop=closed_loop, controller=law)["kf"] for b in (7, 3)]
+    # the same numbers whatever the batch size, and they are the model's per-run draws
+    np.testing.assert_array_equal(out[0].x, out[1].x)
+    np.testing.assert_array_equal(out[0].x[:, 0], Dispersed().truth_model().initial_states(5, 7))
