@@ -28,7 +28,7 @@ def _dense_search(x, x1, w0):
         f = np.sum(((x1k - P @ xk) * W) ** 2, axis=1)
         idx = np.nonzero((f[1:-1] <= f[:-2]) & (f[1:-1] <= f[2:]))[0] + 1
 
-        def fk(d):
+        def fk(d, xk=xk, x1k=x1k):
             return float(np.sum(((x1k - hill_transition(w0 * (1 + d)) @ xk) * W) ** 2))
 
         mins = [minimize_scalar(fk, bounds=(grid[i - 1], grid[i + 1]), method="bounded",
