@@ -38,7 +38,7 @@ def _builders(sc):
             "recursive_hinf": lambda: build_recursive_hinf(sc)}
 
 
-def step_times(scenario=None, *, steps=2000, repeats=3, seed=0, filters=("published", "recursive_hinf", "ekf")):
+def step_times(scenario=None, *, steps=1000, repeats=3, seed=0, filters=("published", "recursive_hinf", "ekf")):
     """Wall-clock time per step of each filter (see the module docstring).
 
     Returns
