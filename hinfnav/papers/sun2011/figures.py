@@ -98,12 +98,13 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default", inse
             ins.axvline(t_zoom_from, color="0.5", ls=":", lw=0.7)
             ins.axhline(0.0, color="0.7", lw=0.5)
             ins.tick_params(labelsize=6)
-            ins.set_title(f"first {2 * t_zoom_from:g} s", fontsize=6, pad=1.5)
+            ins.set_title(f"first {2 * t_zoom_from:g} s", fontsize=6, pad=3)
     if t_zoom_from > result.t[0]:
         early = result.error[run][~m]
         peak = {g: float(np.max(np.abs(state.select(early, g)))) for g in state.groups}
         clipped = ", ".join(f"{g} up to {peak[g]:.3g} {state.group_unit(g)}" for g in state.groups)
-        note = f"y axes clipped: the first {t_zoom_from:g} s (initial error: {clipped}) lie outside"
+        note = (f"y axes clipped: the first {t_zoom_from:g} s (initial error: {clipped}) lie outside"
+                + (" (the insets show them)" if inset else ""))
         wrapped = textwrap.fill(note, 70 if size == "single" else 160)
         txt = fig.text(0.01, 0.005, wrapped, fontsize=7, color="0.35", ha="left", va="bottom")
         txt.set_in_layout(False)
