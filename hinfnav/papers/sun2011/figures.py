@@ -95,8 +95,8 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default", inse
             ins = ax.inset_axes([0.42, 0.6, 0.55, 0.37])
             ins.set_label("inset")
             ins.plot(result.t[early], result.error[run][early, i], lw=0.8)
-            ins.axvline(t_zoom_from, color="0.5", ls=":", lw=0.7)
-            ins.axhline(0.0, color="0.7", lw=0.5)
+            ins.axvline(t_zoom_from, color="0.5", ls=":", lw=0.7, label=f"t = {t_zoom_from:g} s (end of the clip)")
+            ins.axhline(0.0, color="0.7", lw=0.5, label="zero error")
             ins.tick_params(labelsize=6)
             ins.set_title(f"first {2 * t_zoom_from:g} s", fontsize=6, pad=3)
     if t_zoom_from > result.t[0]:
