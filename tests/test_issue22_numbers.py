@@ -223,7 +223,8 @@ def test_claims_table_files(tmp_path):
                "number": {"L1": -0.074, "L3": 0.0059}, "verdict": "does not hold"}]
     csv_path, md_path = write_claims_table(claims, tmp_path, "title")
     text = csv_path.read_text()
-    assert text.splitlines()[0] == "id,figure,claim,statistic,number,paper,verdict"
+    # issue 35 added the paper's words (quote, quote_en) beside the claim
+    assert text.splitlines()[0] == "id,figure,claim,quote,quote_en,statistic,number,paper,verdict"
     assert '"{""L1"":-0.074,""L3"":0.0059}"' in text and "does not hold" in text
     md = md_path.read_text()
     assert md.startswith("# title") and "L3 is biased \\| more than L1" in md

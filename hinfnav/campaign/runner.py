@@ -18,7 +18,7 @@ spec and ``out_dir/results.csv`` the tidy table.
 Each cell also gets its consistency (NEES, NIS, χ² bounds, ``diverged``;
 :mod:`hinfnav.metrics.consistency`) and a ``diverged`` field: true when
 runs blew up (then the status is ``"diverged"`` too) or when the mean NEES
-is far beyond its bound (status ``"ok"``: the estimates are usable, the
+is beyond its 95 % bound (status ``"ok"``: the estimates are usable, the
 covariance is not); :func:`run_campaign` warns
 (:class:`~hinfnav.core.exceptions.FilterDivergenceWarning`) for each such
 cell it computes. The covariance histories this needs are kept for

@@ -36,9 +36,27 @@ closed-form bound (consecutive steps are correlated).
   error; ‖·‖ the Euclidean norm in the state's units), at any step — a
   filter whose covariance grows with its error (strong tracking) can keep
   its NEES small while it runs away, so this bound does not use P(k); or
-* a window's mean NEES exceeds :data:`NEES_FACTOR` (10) times the upper
-  bound of (C3) — the covariance is far too small for the error — or is
-  negative or not finite (the covariance is no longer positive definite).
+* a window's mean NEES exceeds the upper bound of (C3) — the covariance is
+  too small for the error (over-confident: level 1) — or exceeds
+  :data:`NEES_FACTOR` (10) times that bound (grossly over-confident, the
+  covariance is dishonest: level 2), or is negative or not finite (the
+  covariance is no longer positive definite: level 2). The summary's
+  ``diverged_level`` is 0 (consistent), 1 or 2 (the two runaway criteria
+  above are level 2 too); ``diverged`` is ``diverged_level >= 1``. A filter
+  5× over-confident (P a fifth of the error's covariance) has a mean NEES of
+  about 5n, beyond the bound (C3) but below 10× it: flagged at level 1
+  (before issue 35 only level 2 was flagged, and such a filter passed).
+
+**Missing channels** (``missing="skip"``: a NaN innovation channel). The NIS
+of a run at a step uses the channels present only: ν_pᵀ S_pp⁻¹ ν_p, with
+m_i(k) ≤ m degrees of freedom, and Σ_i ε_ν,i(k) ~ χ²(D(k)) with
+D(k) = Σ_i m_i(k); the reported NIS is scaled to the full
+m channels, ε̄_ν(k) = m Σ_i ε_ν,i(k) / D(k) (the average over the channels
+present, times m; equal to the plain run average when nothing is missing),
+and its per-step 95 % bounds are m χ²_{0.025, 0.975}(D(k)) / D(k), used for
+the fraction inside. A step at which no run has a channel has no NIS (NaN)
+and is left out of the window statistics; ``nis_dof_mean`` in a window is the
+mean of D(k)/N over its steps.
 
 Memory does not grow with the runs: :class:`ConsistencyAccumulator` keeps
 per step the sums of ε and ε_ν over the runs (and counts), fed batch by
@@ -199,7 +217,7 @@ class ConsistencyAccumulator:
     def __init__(self, runs: int) -> None:
         self.runs = as_int_at_least("runs", runs, 1)
         self.t = None
-        self.nees_sum = self.nis_sum = None
+        self.nees_sum = self.nis_sum = self.nis_dof = None
         self.n = self.m = None
         self.nees_note = self.nis_note = None
         self.nonfinite_runs = 0
@@ -240,6 +258,7 @@ class ConsistencyAccumulator:
             else:
                 self.m = np.shape(innovation)[-1]
                 self.nis_sum = np.zeros(n1)
+                self.nis_dof = np.zeros(n1)
         finite = np.all(np.isfinite(err), axis=(1, 2))
         self.nonfinite_runs += int((~finite).sum())
         if scale0 is None:
@@ -254,7 +273,14 @@ class ConsistencyAccumulator:
             self.nees_sum += normalized_squared(err, _covariance_history(P, err.shape)).sum(axis=0)
         if self.nis_sum is not None:
             nu = np.asarray(innovation, dtype=float)
-            self.nis_sum += normalized_squared(nu, _covariance_history(S, nu.shape)).sum(axis=0)
+            present = ~np.isnan(nu)
+            C = _covariance_history(S, nu.shape)
+            if not present.all():  # missing channels: the NIS of the channels present (module docstring)
+                both = present[..., :, None] & present[..., None, :]
+                C = np.where(both, C, 0.0) + np.eye(nu.shape[-1]) * ~present[..., None, :]
+                nu = np.where(present, nu, 0.0)
+            self.nis_sum += normalized_squared(nu, C).sum(axis=0)
+            self.nis_dof += present.sum(axis=(0, 2))
         self.added += b
 
     def result(self, name: str = "filter") -> ConsistencyStatistics:
@@ -262,9 +288,16 @@ class ConsistencyAccumulator:
         if self.added != self.runs:
             raise InputError(f"the consistency accumulator was given {self.added} runs of {self.runs}")
         N = self.runs
+        nis = nis_dof = None
+        if self.nis_sum is not None:
+            full = self.nis_dof == N * self.m
+            with np.errstate(all="ignore"):
+                nis = np.where(full, self.nis_sum / N, np.where(self.nis_dof > 0, self.m * self.nis_sum / self.nis_dof,
+                                                                np.nan))
+            nis_dof = None if full.all() else self.nis_dof / N
         return ConsistencyStatistics(
             t=self.t, nees=None if self.nees_sum is None else self.nees_sum / N,
-            nis=None if self.nis_sum is None else self.nis_sum / N, n=self.n, m=self.m, runs=N,
+            nis=nis, n=self.n, m=self.m, runs=N, nis_dof=nis_dof,
             nonfinite_runs=self.nonfinite_runs, grown_runs=self.grown_runs, max_growth=self.max_growth,
             notes=tuple(x for x in (self.nees_note, self.nis_note) if x), name=str(name))
 
@@ -292,6 +325,9 @@ class ConsistencyStatistics:
         Why a quantity is missing.
     name : str
         The filter.
+    nis_dof : ndarray, shape (samples,) or None
+        D(k)/N, the mean number of channels present per run at each step, when
+        some were missing (None: all m were present at every step).
     """
 
     t: np.ndarray
@@ -305,6 +341,7 @@ class ConsistencyStatistics:
     max_growth: float = 0.0
     notes: tuple = ()
     name: str = "filter"
+    nis_dof: np.ndarray = None
 
     @property
     def nees_bounds(self) -> tuple[float, float] | None:
@@ -325,6 +362,15 @@ class ConsistencyStatistics:
                 out[key] = out[f"{key}_inside"] = None
                 continue
             v = values[mask]
+            if key == "nis" and self.nis_dof is not None:  # channels missing: per-step dof and bounds
+                D = self.runs * self.nis_dof[mask]
+                ok = D > 0
+                lo, hi = (self.m * chi2.ppf(q, D[ok]) / D[ok] for q in (0.025, 0.975))
+                v = v[ok]
+                out["nis"] = float(np.mean(v)) if v.size else None
+                out["nis_inside"] = float(np.mean((v >= lo) & (v <= hi))) if v.size else None
+                out["nis_dof_mean"] = float(np.mean(D[ok])) / self.runs if v.size else 0.0
+                continue
             with np.errstate(all="ignore"):
                 out[key] = float(np.mean(v))
                 out[f"{key}_inside"] = float(np.mean((v >= bounds[0]) & (v <= bounds[1])))
@@ -332,12 +378,20 @@ class ConsistencyStatistics:
 
     def divergence(self, windows: Iterable[Sequence[float]] = ()) -> tuple[bool, list[str]]:
         """``(diverged, reasons)`` by the criteria of the module docstring, over the given windows."""
-        reasons = []
+        lev, reasons = self.divergence_level(windows)
+        return lev >= 1, reasons
+
+    def divergence_level(self, windows: Iterable[Sequence[float]] = ()) -> tuple[int, list[str]]:
+        """``(level, reasons)``: 0 consistent, 1 over-confident (mean NEES beyond its 95 % bound), 2 runaway or
+        grossly over-confident (beyond :data:`NEES_FACTOR` times the bound); see the module docstring."""
+        reasons, lev = [], 0
         if self.nonfinite_runs:
             reasons.append(f"{self.nonfinite_runs} of {self.runs} runs have non-finite estimates")
+            lev = 2
         if self.grown_runs:
             reasons.append(f"{self.grown_runs} of {self.runs} runs have an error norm beyond {DIVERGENCE_FACTOR:g} "
                            f"times their initial error scale (largest ratio {self.max_growth:.3g})")
+            lev = 2
         if self.nees is not None:
             hi = self.nees_bounds[1]
             for w in windows:
@@ -345,10 +399,17 @@ class ConsistencyStatistics:
                 if not np.isfinite(mean) or mean < 0:
                     reasons.append(f"mean NEES {mean:.4g} over t = {w[0]:g}..{w[1]:g} s: the covariance is not finite "
                                    "or not positive definite")
+                    lev = 2
                 elif mean > NEES_FACTOR * hi:
                     reasons.append(f"mean NEES {mean:.4g} over t = {w[0]:g}..{w[1]:g} s is beyond {NEES_FACTOR:g} "
-                                   f"times its 95 % upper bound {hi:.4g} (n = {self.n}, {self.runs} runs)")
-        return bool(reasons), reasons
+                                   f"times its 95 % upper bound {hi:.4g} (n = {self.n}, {self.runs} runs): grossly "
+                                   "over-confident")
+                    lev = 2
+                elif mean > hi:
+                    reasons.append(f"mean NEES {mean:.4g} over t = {w[0]:g}..{w[1]:g} s is beyond its 95 % upper bound "
+                                   f"{hi:.4g} (n = {self.n}, {self.runs} runs): over-confident")
+                    lev = max(lev, 1)
+        return lev, reasons
 
     def summary(self, windows: Mapping[str, Sequence[float]]) -> dict[str, Any]:
         """JSON-ready: bounds, per-window NEES/NIS, ``diverged`` and its reasons, the notes.
@@ -358,12 +419,13 @@ class ConsistencyStatistics:
         windows : dict
             Name → (start, end), s.
         """
-        diverged, reasons = self.divergence(windows.values())
+        level, reasons = self.divergence_level(windows.values())
+        diverged = level >= 1
         lo_hi = lambda b: None if b is None else list(b)
         return {"nees_dof": self.n if self.nees is not None else None, "nis_dof": self.m if self.nis is not None else None,
                 "nees_bounds": lo_hi(self.nees_bounds), "nis_bounds": lo_hi(self.nis_bounds),
                 "windows": {name: self.window(w) for name, w in windows.items()},
-                "diverged": diverged, "diverged_reasons": reasons, "nonfinite_runs": self.nonfinite_runs,
+                "diverged": diverged, "diverged_level": level, "diverged_reasons": reasons, "nonfinite_runs": self.nonfinite_runs,
                 "diverged_runs": self.grown_runs + self.nonfinite_runs, "notes": list(self.notes)}
 
 

@@ -1,8 +1,9 @@
 """A paper's claims as a table file (CSV and Markdown), as the papers with a results table write one.
 
 Rows are claim records: ``claim``, ``verdict``, and where the paper's
-module gives them ``id``, ``figure``, ``statistic``, ``number`` (ours) and
-``paper``. Numbers that are dicts or lists are written as compact JSON.
+module gives them ``id``, ``figure``, ``quote`` (the paper's words, original
+language), ``quote_en`` (an English rendering), ``statistic``, ``number``
+(ours) and ``paper``. Numbers that are dicts or lists are written as compact JSON.
 """
 
 import csv
@@ -16,7 +17,7 @@ from ..io.outputs import atomic_write_text, to_json
 __all__ = ["CLAIM_COLUMNS", "claims_rows", "format_claims_table", "write_claims_table"]
 
 #: The columns, in order.
-CLAIM_COLUMNS = ("id", "figure", "claim", "statistic", "number", "paper", "verdict")
+CLAIM_COLUMNS = ("id", "figure", "claim", "quote", "quote_en", "statistic", "number", "paper", "verdict")
 
 
 def _cell(v, limit=None):
@@ -36,18 +37,18 @@ def claims_rows(claims):
         if not isinstance(c, dict) or "claim" not in c or "verdict" not in c:
             raise InputError(f"claims entry {key!r} must be a dict with 'claim' and 'verdict'")
         rows.append({"id": str(c.get("id", key)), "figure": c.get("figure"), "claim": c["claim"],
-                     "statistic": c.get("statistic"), "number": c.get("number", c.get("ours")),
+                     "quote": c.get("quote"), "quote_en": c.get("quote_en"), "statistic": c.get("statistic"), "number": c.get("number", c.get("ours")),
                      "paper": c.get("paper"), "verdict": c["verdict"]})
     return rows
 
 
 def format_claims_table(claims, title):
-    """The claims as Markdown (numbers shortened to 200 characters; the CSV has them whole)."""
+    """The claims as Markdown (numbers shortened to 200 characters; the CSV has them whole; quotes whole)."""
     rows = claims_rows(claims)
     cols = [c for c in CLAIM_COLUMNS if any(r[c] is not None for r in rows)]
     lines = [f"# {title}", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
-        lines.append("| " + " | ".join(_cell(r[c], 200).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
+        lines.append("| " + " | ".join(_cell(r[c], None if c.startswith("quote") else 200).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
     return "\n".join(lines) + "\n"
 
 

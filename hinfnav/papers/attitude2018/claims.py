@@ -13,6 +13,7 @@ __all__ = [
     "CLAIMS",
     "COMPARABLE_FACTOR",
     "CORRELATION_THRESHOLD",
+    "QUOTES",
     "INSENSITIVE_FACTOR",
     "PLATEAU_ELASTICITY",
     "format_claims",
@@ -28,6 +29,30 @@ CLAIMS = {
     3: "the ASTEKF is insensitive to Q; a small Q (1e-16 I3) gives both low random error and no bias",
     4: "the AAEKF's errors flatten into plateaus at the peaks",
     5: "the best AEKF, the ASTEKF and the AAEKF perform comparably; ease of use AAEKF > ASTEKF > AEKF",
+}
+#: The paper's words behind each claim (Section 3, the original's traditional characters) and an English rendering.
+QUOTES = {
+    1: ("從圖中可以看出,干擾力矩和歐拉角估計誤差呈周期性變化,且其變化周期剛好與圖1中顯示的干擾力矩的變化周期一致。在干擾力矩的峰值處"
+        "(變化率最小處)估計誤差最小,相反在干擾力矩過零處(變化率最大處)估計誤差最大。",
+        "The figures show that the torque and Euler-angle estimation errors vary periodically, with exactly the periods "
+        "of the disturbance torque of Fig 1. The error is smallest at the torque's peaks (where its rate is smallest) "
+        "and largest at its zero crossings (where its rate is largest)."),
+    2: ("較大的系統噪聲雖然可以抑制估計結果的振蕩誤差,但同時隨機誤差也會增大;采用較小的系統噪聲,隨機誤差會減小,但估計結果會有很大的"
+        "振蕩誤差。…對于AEKF而言,系統噪聲不能太大,也不能太小,這里顯示估計性能最好時的結果,此時Q=10-14·I3。",
+        "A larger process noise suppresses the oscillating error of the estimate but raises the random error; a smaller "
+        "one lowers the random error but leaves a large oscillating error. ... For the AEKF the process noise must be "
+        "neither too large nor too small; shown is the best performance, at Q = 1e-14 I3."),
+    3: ("但是ASTEKF結果受系統噪聲的影響較小,且小系統噪聲的估計不僅隨機噪聲較小,誤差的偏離也得到了抑制。因此在使用ASTEKF時,不用擔心"
+        "過小的系統噪聲會跟蹤不上干擾力矩的變化帶來的偏差。",
+        "But the ASTEKF's results depend little on the process noise, and with a small process noise the estimate has "
+        "both a small random error and a suppressed deviation. So with the ASTEKF one need not fear the bias of a "
+        "process noise too small to follow the torque's changes."),
+    4: ("與AEKF不同,在估計誤差的峰值處都呈現平臺狀,有效地抑制了峰值處干擾力矩變化帶來的估計誤差。",
+        "Unlike the AEKF, the estimation errors form plateaus at their peaks, effectively suppressing the error that the "
+        "torque's change causes there."),
+    5: ("從圖中可以看出,AEKF和ASTEKF的最優性能與AAEKF的性能相當。三種濾波器的可操作性依次是AAEKF優于ASTEKF,ASTEKF又優于AEKF。",
+        "The figures show that the best performance of the AEKF and the ASTEKF is comparable with the AAEKF's. In ease "
+        "of use the AAEKF is better than the ASTEKF, and the ASTEKF better than the AEKF."),
 }
 #: Two filters "perform comparably" when their RMS errors differ by less than this factor.
 COMPARABLE_FACTOR = 1.5
@@ -219,7 +244,8 @@ def measure_claims(study, which=(1, 2, 3, 4, 5)):
     3–5 need the whole :func:`~.studies.attitude_study`.
     """
     fns = {1: _claim1, 2: _claim2, 3: _claim3, 4: _claim4, 5: _claim5}
-    return {str(i): {"claim": CLAIMS[i], **fns[i](study)} for i in which}
+    return {str(i): {"claim": CLAIMS[i], "quote": QUOTES[i][0], "quote_en": QUOTES[i][1], **fns[i](study)}
+            for i in which}
 
 
 def format_claims(claims):

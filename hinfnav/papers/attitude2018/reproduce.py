@@ -5,6 +5,7 @@ import numpy as np
 from ...io.outputs import to_json
 from ...core.validation import as_int_at_least
 from ..claims_table import write_claims_table
+from ..verdicts import format_status, paper_status
 from ..skeleton import Reproduction
 from .chaser import chaser_study, format_chaser_table, plot_chaser
 from .claims import format_claims, measure_claims
@@ -128,7 +129,9 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
     if ch is not None:
         figs["fig12_chaser"] = lambda: plot_chaser(ch)
     rep.save_figures(figs)
-    summary = rep.write_summary(summarize(study, claims, ch))
+    summary = summarize(study, claims, ch)
+    summary["status"] = paper_status("attitude2018", summary)
+    summary = rep.write_summary(summary)
     write_claims_table(claims, rep.out, "Paper 002 (gyroless attitude, 2018): the claims, their statistics and verdicts")
     if notebooks:
         rep.run_notebooks()
@@ -136,6 +139,7 @@ def reproduce(out_dir="results/attitude2018", *, seed=0, runs=20, notebooks=Fals
         print(f"\norbit rate {summary['orbit_rate_deg_s']:.14f} deg/s (paper {PAPER_OMEGA_E_DEG_S}), "
               f"relative difference {summary['orbit_rate_check']['relative_difference']:.1e}")
         print(format_claims(claims))
+        print(format_status("attitude2018", summary["status"]))
         if ch is not None:
             print("\nSun 2011's chaser, control law unknown (mean of per-run RMS over axes, 95 % interval):")
             print(format_chaser_table(ch))

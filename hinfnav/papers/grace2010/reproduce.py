@@ -197,7 +197,7 @@ def reproduce(out_dir="results/grace2010", *, seed=0, runs=1, notebooks=False, p
         "kband_noise": kband_noise(data),
         "mismatch": {
             "propagation": {k: v for k, v in prop.items() if k not in ("growth", "growth_t_s")},
-            "one_step": {k: v for k, v in one.items() if k not in ("e", "delta", "Q_mismatch")},
+            "one_step": {k: v for k, v in one.items() if k not in ("e", "delta", "delta_minima", "Q_mismatch")},
             "one_step_Q_hill_std": np.sqrt(np.diag(one["Q_mismatch"])),
             "one_step_Q_two_body_j2_std": study["Q_j2_std"],
         },

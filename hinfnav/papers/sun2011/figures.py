@@ -45,18 +45,22 @@ def _fonts(fig, size):
     if fig._suptitle is not None:
         fig._suptitle.set_size(pt + 0.5)
         fig._suptitle.set_text(textwrap.fill(fig._suptitle.get_text(), 48 if size == "single" else 100))
-    grid = np.asarray(fig.axes).reshape(2, -1) if len(fig.axes) % 2 == 0 else None
+    main = [ax for ax in fig.axes if ax.get_label() != "inset"]
+    grid = np.asarray(main).reshape(2, -1) if len(main) % 2 == 0 else None
     if grid is not None:
         for ax in grid[0]:
             ax.set_xlabel("")
 
 
-def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default"):
+def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default", inset=True):
     """Per-axis position and velocity errors of one run (the layout of Figs 2–5, 7).
 
     The y limits leave out the first ``t_zoom_from`` seconds (the 30–40 m
     initial error), as the paper's figures do; a note under the figure says
-    what was clipped.
+    what was clipped, and (``inset``, not at the single-column size) an inset
+    in the upper part of each panel shows those first seconds (to twice
+    ``t_zoom_from``) on their own y scale, where the paper claims the fast
+    convergence.
 
     Parameters
     ----------
@@ -67,6 +71,8 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default"):
         Seconds left out of the y limits, s.
     size : {"default", "single", "double"}
         12 × 5.5 in (screen), 3.5 in (one journal column) or 7 in (full width).
+    inset : bool
+        Draw the inset of the first seconds.
 
     Returns
     -------
@@ -79,13 +85,26 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default"):
     m = result.t >= t_zoom_from
     err = result.error[run][m]
     lim = lambda a: 1.15 * max(np.max(np.abs(a)), 1e-6)
-    ylims = {g: (-lim(state.select(err, g)), lim(state.select(err, g))) for g in state.groups}
+    inset = bool(inset) and size != "single" and t_zoom_from > result.t[0]
+    top = 2.8 if inset else 1.0  # room above the error band for the inset
+    ylims = {g: (-lim(state.select(err, g)), top * lim(state.select(err, g))) for g in state.groups}
     plot_errors(result, axes=axes, run=run, ylims=ylims, title=title)
+    if inset:
+        early = result.t <= 2 * t_zoom_from
+        for i, ax in enumerate(fig.axes[:state.n]):
+            ins = ax.inset_axes([0.42, 0.6, 0.55, 0.37])
+            ins.set_label("inset")
+            ins.plot(result.t[early], result.error[run][early, i], lw=0.8)
+            ins.axvline(t_zoom_from, color="0.5", ls=":", lw=0.7, label=f"t = {t_zoom_from:g} s (end of the clip)")
+            ins.axhline(0.0, color="0.7", lw=0.5, label="zero error")
+            ins.tick_params(labelsize=6)
+            ins.set_title(f"first {2 * t_zoom_from:g} s", fontsize=6, pad=3)
     if t_zoom_from > result.t[0]:
         early = result.error[run][~m]
         peak = {g: float(np.max(np.abs(state.select(early, g)))) for g in state.groups}
         clipped = ", ".join(f"{g} up to {peak[g]:.3g} {state.group_unit(g)}" for g in state.groups)
-        note = f"y axes clipped: the first {t_zoom_from:g} s (initial error: {clipped}) lie outside"
+        note = (f"y axes clipped: the first {t_zoom_from:g} s (initial error: {clipped}) lie outside"
+                + (" (the insets show them)" if inset else ""))
         wrapped = textwrap.fill(note, 70 if size == "single" else 160)
         txt = fig.text(0.01, 0.005, wrapped, fontsize=7, color="0.35", ha="left", va="bottom")
         txt.set_in_layout(False)

@@ -120,7 +120,7 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
                          "(RMS over x, y, z of each run's per-axis RMS; run 0, and mean over runs)",
         "nees": cw["nees"], "nees_dof": cs["nees_dof"], "nees_bounds": cs["nees_bounds"], "nees_inside": cw["nees_inside"],
         "nis": cw["nis"], "nis_dof": cs["nis_dof"], "nis_bounds": cs["nis_bounds"], "nis_inside": cw["nis_inside"],
-        "diverged": cs["diverged"], "diverged_reasons": cs["diverged_reasons"], "consistency_notes": cs["notes"],
+        "diverged": cs["diverged"], "diverged_level": cs["diverged_level"], "diverged_reasons": cs["diverged_reasons"], "consistency_notes": cs["notes"],
         "provenance": provenance(seed=int(seed), runs=int(runs)),
     }
 

@@ -115,7 +115,8 @@ def fig5(result, *, axis=0, run=0):
         plot_series(t, 1e3 * result.passive[name][run, :, 6 + axis][s], ax=ax, label=name, color=_COLORS[name],
                     ylabel="F$_{Dsc,x}$ estimate (mN)")
     ax.legend(loc="upper right", fontsize=8)
-    fig.suptitle("Fig 5 analogue: saturated accelerometer, Algorithm 2 as L1 / L2 (ideal) / L3 (skip)")
+    fig.suptitle("Fig 5 analogue, drag-free loop OPEN (F_Csc = 0)\nsaturated accelerometer, Algorithm 2 as "
+                 "L1 / L2 (ideal) / L3 (skip)")
     return fig
 
 

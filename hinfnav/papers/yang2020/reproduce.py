@@ -19,6 +19,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from ...io.progress import bar_disabled
 from ..claims_table import write_claims_table
+from ..verdicts import format_status, paper_status
 from ..skeleton import Reproduction
 from .claims import evaluate_claims
 from .constants import CITATION, READING_REASONS, REQUIREMENT_ASD, TABLE2
@@ -249,6 +250,7 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         "integral_readings": integral,
     }
     summary["claims"] = evaluate_claims(summary)
+    summary["status"] = paper_status("yang2020", summary)
     timings["total_s"] = rep.elapsed_s
     summary["timing_s"] = timings
     summary = rep.write_summary(summary, strict=True)
@@ -259,4 +261,5 @@ def reproduce(out_dir="results/yang2020", *, seed=0, runs=1, notebooks=False, pr
         print(f"\nYang et al. 2020: done in {timings['total_s']:.0f} s")
         for c in summary["claims"]:
             print(f"  [{c['verdict']}] {c['figure']}: {c['claim']}")
+        print(format_status("yang2020", summary["status"]))
     return summary

@@ -14,7 +14,7 @@ from scipy.signal import welch
 from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
-from .constants import REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
+from .constants import ACTUATOR_BOUND, REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
 from .filters import build_alg1, build_alg2
 from .loop import Alg2Bank, LoopResult, residual_acceleration
 
@@ -179,15 +179,46 @@ def periodic_amplitude(signal, t, w):
     return float(np.hypot(coef[0], coef[1]).mean())
 
 
-def step_response(result, *, tolerance=0.05):
-    """The attitude step of Fig 11: settling, overshoot, and the relative-attitude excursion it causes.
+def _edge(phi, target, step, torque, bound, dt, tolerance):
+    """Settling, overshoot and torque saturation of one edge of the step, per axis.
+
+    ``phi`` (n, 3) is the run-averaged attitude from the edge on, ``target`` (3,) what it is commanded to,
+    ``step`` (3,) the signed change of the command at the edge (target minus the command before),
+    ``torque`` (runs, n, 3) the applied attitude torques, N m. The overshoot is how far ``phi`` goes past
+    ``target`` in the direction of the step, as a fraction of ``|step|``; ``settling_s`` the time from the
+    edge after which ``|phi - target|`` stays within ``tolerance |step|``; ``torque_saturated_steps`` the
+    steps (run-averaged) with ``|u| >= bound`` (the clip (13) active).
+    """
+    out = {}
+    for a, name in enumerate(("pitch", "yaw", "roll")):
+        err = phi[:, a] - target[a]
+        outside = np.nonzero(np.abs(err) > tolerance * abs(step[a]))[0]
+        past = np.sign(step[a]) * err
+        out[name] = {
+            "settling_s": float((outside[-1] + 1) * dt) if outside.size else 0.0,
+            "overshoot": float(max(0.0, past.max() / abs(step[a]))),
+            "torque_saturated_steps": float(np.mean(np.sum(np.abs(torque[:, :, a]) >= bound * (1 - 1e-12), axis=1))),
+        }
+    return out
+
+
+def step_response(result, *, tolerance=0.05, bound=ACTUATOR_BOUND):
+    """The attitude step of Fig 11, both edges: settling, overshoot, torque saturation, relative-attitude excursion.
+
+    The paper commands φ_sc = (0.01, 0.02, 0.03) rad at k = 1×10⁵ **and returns to the original attitude at
+    k = 2×10⁵**; both edges are measured, each from its own command change.
 
     Returns
     -------
     dict
-        Per axis (pitch, yaw, roll): ``settling_s`` (to within ``tolerance`` of the step, after the
-        command), ``overshoot`` (fraction of the step), ``rel_attitude_peak_rad`` (largest ``|φ_rel|`` in
-        the 1000 s after the command) and ``rel_attitude_before_rad`` (largest ``|φ_rel|`` in the 1000 s before).
+        ``axes``: per axis (pitch, yaw, roll) of the first edge (command on): ``settling_s`` (to within
+        ``tolerance`` of the step, after the command), ``overshoot`` (fraction of the step),
+        ``rel_attitude_peak_rad`` (largest ``|φ_rel|`` in the 1000 s after the command),
+        ``rel_attitude_before_rad`` (largest ``|φ_rel|`` in the 1000 s before) and ``torque_saturated_steps``
+        (steps with the attitude torque on its bound ``bound``, N m, between the two edges).
+        ``return_edge``: the same for the return to zero at ``step_off_s`` (overshoot past zero as a fraction
+        of the step; settling and saturation counted from the return to the end of the run; the
+        relative-attitude peak in the 1000 s after it); absent when the run ends before the return.
     """
     ref = result.reference
     on = np.nonzero(np.any(ref != 0, axis=1))[0]
@@ -199,6 +230,7 @@ def step_response(result, *, tolerance=0.05):
     win = int(1000.0 / dt)
     phi = result.x[:, k_on:k_off, 0:3].mean(axis=0)
     out = {"step_on_s": float(result.t[k_on]), "step_off_s": float(result.t[min(k_off, len(result.t) - 1)]), "axes": {}}
+    first = _edge(phi, STEP_COMMAND, STEP_COMMAND, result.u[:, k_on:k_off, 0:3], bound, dt, tolerance)
     for a, name in enumerate(("pitch", "yaw", "roll")):
         err = np.abs(phi[:, a] - STEP_COMMAND[a])
         outside = np.nonzero(err > tolerance * STEP_COMMAND[a])[0]
@@ -209,7 +241,15 @@ def step_response(result, *, tolerance=0.05):
             "overshoot": float(max(0.0, (phi[:, a].max() - STEP_COMMAND[a]) / STEP_COMMAND[a])),
             "rel_attitude_peak_rad": float(np.abs(rel[k_on:k_on + win]).max()),
             "rel_attitude_before_rad": float(np.abs(rel[max(0, k_on - win):k_on]).max()),
+            "torque_saturated_steps": first[name]["torque_saturated_steps"],
         }
+    if k_off < len(result.t):
+        back = _edge(result.x[:, k_off:, 0:3].mean(axis=0), np.zeros(3), -STEP_COMMAND, result.u[:, k_off:, 0:3],
+                     bound, dt, tolerance)
+        for a, name in enumerate(("pitch", "yaw", "roll")):
+            rel = result.x[:, :, 12 + a].mean(axis=0)
+            back[name]["rel_attitude_peak_rad"] = float(np.abs(rel[k_off:k_off + win]).max())
+        out["return_edge"] = {"time_s": float(result.t[k_off]), "axes": back}
     return out
 
 
