@@ -79,8 +79,13 @@ class ScenarioProtocol(Protocol):
 
 
 @runtime_checkable
-class OwnTruthScenario(ScenarioProtocol, Protocol):
-    """A scenario that simulates its own truth (a manoeuvre, a plant the generic simulation cannot make)."""
+class OwnTruthScenario(Protocol):
+    """The optional hook of a scenario that simulates its own truth (a manoeuvre, a plant the generic
+    simulation cannot make): the Monte Carlo engine calls it instead of ``truth_model``.
+
+    A hook protocol: ``isinstance(s, OwnTruthScenario)`` checks this member alone (a scenario is
+    one that also satisfies :class:`ScenarioProtocol`).
+    """
 
     def simulate_truth(self, *, noise: Any = "gaussian", measurement_noise: Any = None, runs: int = 1,
                        seed: int | np.random.SeedSequence = 0, first_run: int = 0, **conditions: Any) -> Any:
@@ -93,8 +98,10 @@ class OwnTruthScenario(ScenarioProtocol, Protocol):
 
 
 @runtime_checkable
-class CampaignTruthScenario(ScenarioProtocol, Protocol):
-    """A campaign scenario whose truth takes the campaign's noise per channel or an impulse."""
+class CampaignTruthScenario(Protocol):
+    """The optional hook of a campaign scenario whose truth takes the campaign's noise per channel or an
+    impulse: a campaign cell and the Monte Carlo engine call it first (a hook protocol, as
+    :class:`OwnTruthScenario`)."""
 
     def campaign_truth(self, conditions: Mapping[str, Any], noise: Any,
                        rngs: Sequence[np.random.Generator]) -> Any:
