@@ -63,8 +63,10 @@ class ScenarioProtocol(Protocol):
         The filters' initial error covariance (units² of the state).
     ``offers`` : :class:`hinfnav.estimators.registry.Offers`
         What estimators built by name may rely on (the models, the error form).
-    ``kalman_model(**conditions)``
-        The linear model the benchmark's Kalman-type filters are built on.
+    ``kalman_model()``
+        The model the generic filters (``model_ekf``, ``model_ukf``, ``model_hbf``,
+        ``model_stekf``) are built on: a dict with ``system``, ``measurement``,
+        ``P0`` (state units²) and ``uses_input`` (with ``offers.models`` holding ``"kalman"``).
     ``estimator_from_design(design)``
         The estimator of a :class:`DesignResultProtocol` (the LTI filter (12)
         for Sun et al. 2011), so that :func:`hinfnav.sim.simulate` takes a design.
