@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import pytest
+
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
@@ -32,6 +34,7 @@ def test_your_own_system_runs_verbatim(capsys):
         assert err < 30.0, out
 
 
+@pytest.mark.slow  # a campaign of 4 cells × 100 runs: about 2 s
 def test_bring_your_own_scenario_runs_verbatim(monkeypatch, capsys):
     import numpy as np
     from scipy.linalg import solve_discrete_are
