@@ -39,6 +39,10 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
         CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
         UnstablePlantError,
     )
+    from .core import (
+        CampaignTruthScenario, DesignResultProtocol, DynamicsProtocol, EstimatorHooks, MeasurementProtocol,
+        OwnTruthScenario, ScenarioProtocol, TruthModelProtocol,
+    )
     from .systems import (
         hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
         position_from_range_angles, range_angles, RangeAzimuthElevation, Saturated, StateSpec,
@@ -177,6 +181,15 @@ __all__ = [
     "convergence_time",
     "monte_carlo_summary",
     "monte_carlo_statistics",
+    # protocols (hinfnav.core.protocols): what your own scenario, system, sensor, filter, design offer
+    "ScenarioProtocol",
+    "OwnTruthScenario",
+    "CampaignTruthScenario",
+    "TruthModelProtocol",
+    "DynamicsProtocol",
+    "MeasurementProtocol",
+    "EstimatorHooks",
+    "DesignResultProtocol",
     # errors
     "HinfnavError",
     "InputError",

@@ -53,7 +53,10 @@ def _own(cls: type, name: str):
         if name in vars(klass):
             if not getattr(klass, "__module__", "").startswith("hinfnav"):
                 return None
-            return vars(klass)[name]
+            member = vars(klass)[name]
+            if inspect.isfunction(member) and not member.__module__.startswith("hinfnav"):
+                return None  # typing.Protocol sets each protocol class's __init__ to its own (typing's)
+            return member
     return None
 
 

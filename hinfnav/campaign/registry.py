@@ -40,7 +40,7 @@ def register_scenario(name: str, factory: Callable[..., Any], *, description: st
         The name a campaign uses (the paper's key).
     factory : callable
         Returns an object with ``truth_model(**conditions)`` and ``xhat0``
-        (the scenario protocol of :mod:`hinfnav.sim`); called with no
+        (:class:`~hinfnav.core.protocols.ScenarioProtocol`); called with no
         argument it gives the paper's scenario. Optional: ``offers`` (an
         :class:`~hinfnav.estimators.registry.Offers`: what its estimators may
         rely on) and ``campaign_truth(conditions, noise, rngs)`` returning a

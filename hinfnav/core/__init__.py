@@ -23,6 +23,10 @@ from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, a
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .linalg import as_covariance, discretize, spectral_radius, sym
+    from .protocols import (
+        CampaignTruthScenario, DesignResultProtocol, DynamicsProtocol, EstimatorHooks, MeasurementProtocol,
+        OwnTruthScenario, ScenarioProtocol, TruthModelProtocol,
+    )
 
 __all__ = [
     "HinfnavError",
@@ -44,6 +48,14 @@ __all__ = [
     "spectral_radius",
     "sym",
     "discretize",
+    "ScenarioProtocol",
+    "OwnTruthScenario",
+    "CampaignTruthScenario",
+    "TruthModelProtocol",
+    "DynamicsProtocol",
+    "MeasurementProtocol",
+    "EstimatorHooks",
+    "DesignResultProtocol",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)

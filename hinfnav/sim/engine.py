@@ -58,6 +58,7 @@ from tqdm import tqdm
 
 from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
+from ..core.protocols import CampaignTruthScenario, OwnTruthScenario
 from ..io.progress import bar_disabled
 from ..core.validation import as_int_at_least
 from ..estimators.base import EstimateHistory, Estimator
@@ -187,24 +188,24 @@ def truth_batch(scenario: Any, conditions: Mapping[str, Any], *, noise: str | No
                 model: TruthModel | None = None) -> Truth:
     """The truth of runs ``first_run … first_run + runs − 1`` of ``scenario`` under ``conditions``.
 
-    The scenario's own ``simulate_truth`` when it has one (see the module
-    docstring), or its ``campaign_truth(conditions, noise, rngs)`` (``rngs`` the
-    runs' child generators of ``seed``, as the simulators draw them: an
-    impulse, another noise per channel…), else
-    :func:`~hinfnav.sim.truth.simulate_truth` of ``model`` (default
-    ``scenario.truth_model(**conditions)``).
+    The scenario's ``campaign_truth(conditions, noise, rngs)`` when it has one
+    (:class:`~hinfnav.core.protocols.CampaignTruthScenario`; ``rngs`` the runs'
+    child generators of ``seed``, as the simulators draw them: an impulse,
+    another noise per channel…), else its own ``simulate_truth``
+    (:class:`~hinfnav.core.protocols.OwnTruthScenario`, see the module
+    docstring), else :func:`~hinfnav.sim.truth.simulate_truth` of ``model``
+    (default ``scenario.truth_model(**conditions)``,
+    :class:`~hinfnav.core.protocols.ScenarioProtocol`).
     """
-    campaign = getattr(scenario, "campaign_truth", None)
-    if callable(campaign):
-        truth = campaign(dict(conditions), noise, child_rngs(seed, runs, first_run))
+    if isinstance(scenario, CampaignTruthScenario):
+        truth = scenario.campaign_truth(dict(conditions), noise, child_rngs(seed, runs, first_run))
         if not isinstance(truth, Truth):
             raise InputError(f"{type(scenario).__name__}.campaign_truth must return a hinfnav Truth; "
                              f"got {type(truth).__name__}")
         return truth
-    own = getattr(scenario, "simulate_truth", None)
-    if callable(own):
-        truth = own(noise=noise, measurement_noise=measurement_noise, runs=runs, seed=seed, first_run=first_run,
-                    **conditions)
+    if isinstance(scenario, OwnTruthScenario):
+        truth = scenario.simulate_truth(noise=noise, measurement_noise=measurement_noise, runs=runs, seed=seed,
+                                        first_run=first_run, **conditions)
         if not isinstance(truth, Truth):
             raise InputError(f"{type(scenario).__name__}.simulate_truth must return a hinfnav Truth; "
                              f"got {type(truth).__name__}")
@@ -221,7 +222,7 @@ def truth_batches(scenario: Any, conditions: Mapping[str, Any], *, runs: int, ba
     runs = as_int_at_least("runs", runs, 1)
     batch_size = as_int_at_least("batch_size", batch_size, 1)
     seed = plain_seed(seed)
-    own = callable(getattr(scenario, "simulate_truth", None)) or callable(getattr(scenario, "campaign_truth", None))
+    own = isinstance(scenario, (OwnTruthScenario, CampaignTruthScenario))
     model = None if own else scenario_truth_model(scenario, dict(conditions))
     for start in range(0, runs, batch_size):
         yield start, truth_batch(scenario, conditions, noise=noise, measurement_noise=measurement_noise,

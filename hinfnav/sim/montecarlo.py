@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
+from ..core.protocols import OwnTruthScenario
 from ..core.validation import as_int_at_least
 from ..estimators.base import Estimator
 from .engine import (
@@ -161,7 +162,7 @@ def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noi
         :func:`hinfnav.metrics.consistency` gives the NEES, the NIS and the
         divergence flag of the result.
     """
-    if not callable(getattr(scenario, "simulate_truth", None)):
+    if not isinstance(scenario, OwnTruthScenario):
         check_history_memory(scenario, runs, **conditions)
     estimator = resolve_estimator(scenario, estimator)
     out = run_monte_carlo(scenario, {estimator.name: estimator}, sink=HistorySink(scenario.xhat0, runs), runs=runs,

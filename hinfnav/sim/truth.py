@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
+from ..core.protocols import ScenarioProtocol
 from ..core.validation import as_int_at_least, as_vector
 from ..noise import ColoredNoise, make_noise
 
@@ -145,15 +146,16 @@ class Truth:
 
 
 def scenario_truth_model(scenario: Any, conditions: dict[str, Any]) -> TruthModel:
-    """``scenario.truth_model(**conditions)``, after checking that ``scenario`` is one and knows every condition.
+    """``scenario.truth_model(**conditions)``, after checking that ``scenario`` is one
+    (:class:`~hinfnav.core.protocols.ScenarioProtocol`) and knows every condition.
 
     Raises :class:`InputError` naming an unknown condition (e.g. a misspelt
     ``maneuvre=``) and the ones the scenario takes, instead of a TypeError.
     """
-    build = getattr(scenario, "truth_model", None)
-    if not callable(build) or not hasattr(scenario, "xhat0"):
-        raise InputError(f"scenario must offer truth_model(**conditions) and xhat0 (such as a paper's Scenario, hinfnav.papers.<key>.Scenario); "
-                         f"got {type(scenario).__name__}")
+    if not isinstance(scenario, ScenarioProtocol):
+        raise InputError(f"scenario must offer truth_model(**conditions) and xhat0 (hinfnav.ScenarioProtocol; such as a "
+                         f"paper's Scenario, hinfnav.papers.<key>.Scenario); got {type(scenario).__name__}")
+    build = scenario.truth_model
     try:
         params = inspect.signature(build).parameters.values()
     except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
