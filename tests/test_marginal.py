@@ -169,3 +169,27 @@ def test_flexible_attitude_closed_loop_20pct_designs_and_certifies():
     for cell in poly.cells:
         alphas += list(rng.dirichlet(np.ones(len(cell)), size=3) @ eye[list(cell)])
     assert _full_error_response_worst(poly, alphas, res.A_F, res.B_F, res.C_F, poly.dt) <= res.gamma * (1 + 1e-9)
+
+
+def test_drift_simulation_matches_the_error_system_and_its_energy_bound():
+    from hinfnav.sim.drift import cell_sweep_weights, simulate_drift
+
+    poly = flexible_attitude()
+    c = poly.center()
+    B_F = np.array([[-0.5], [-1.0], [0.0], [0.0]])  # a stabilising rigid-body gain (|eig(A + B_F C)| < 1 checked)
+    A_F, C_F = c.A + B_F @ c.C, -c.L
+    assert np.max(np.abs(np.linalg.eigvals(A_F))) < 1
+    rng = np.random.default_rng(3)
+    K = 400
+    w, v = rng.standard_normal((K, 1)), rng.standard_normal((K, 1))
+    alphas = cell_sweep_weights(poly, np.full(K, 0.5), 0.5)  # constant: the barycentre
+    assert np.allclose(alphas, 0.25)
+    run = simulate_drift(poly, A_F, B_F, C_F, alphas, w, v)
+    # independent: the same run by control.forced_response of the full error system (13)–(14), 1e-9
+    import control
+    n = 4
+    Ab = np.block([[c.A, np.zeros((n, n))], [B_F @ c.C, A_F]])
+    Bb = np.block([[c.B, np.zeros((n, 1))], [np.zeros((n, 1)), B_F @ c.D]])
+    out = control.forced_response(control.ss(Ab, Bb, np.hstack([c.L, -C_F]), 0, 0.1), U=np.vstack([w.T, v.T]))
+    assert np.allclose(run.e[:, 0], np.ravel(out.outputs), atol=1e-9 * max(1.0, np.abs(run.e).max()))
+    assert np.allclose(run.error_energy[-1], np.sum(run.e ** 2)) and run.gain > 0
