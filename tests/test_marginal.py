@@ -193,3 +193,38 @@ def test_drift_simulation_matches_the_error_system_and_its_energy_bound():
     out = control.forced_response(control.ss(Ab, Bb, np.hstack([c.L, -C_F]), 0, 0.1), U=np.vstack([w.T, v.T]))
     assert np.allclose(run.e[:, 0], np.ravel(out.outputs), atol=1e-9 * max(1.0, np.abs(run.e).max()))
     assert np.allclose(run.error_energy[-1], np.sum(run.e ** 2)) and run.gain > 0
+
+
+def test_toml_cells_are_read_and_checked(tmp_path):
+    from pathlib import Path
+
+    from hinfnav.core.exceptions import InputError
+    from hinfnav.systems import read_system_file
+
+    root = Path(__file__).resolve().parents[1]
+    poly = read_system_file(root / "examples" / "flexible_attitude_20pct.toml")
+    ref = flexible_attitude(splits=8)  # the file is generated from it (examples/make_flexible_attitude.py): exact
+    assert poly.cells == ref.cells and all(np.array_equal(a.A, b.A) and np.array_equal(a.B, b.B)
+                                           for a, b in zip(poly.vertices, ref.vertices))
+    text = (root / "examples" / "two_mass_spring_30pct.toml").read_text(encoding="utf-8")
+    for bad, match in (('cells = "all"', "cells"), ("cells = [[0, 5]]", "vertex indices"), ("cells = [[0]]", "every")):
+        f = tmp_path / "c.toml"
+        f.write_text(text.replace('kind = "polytope"', 'kind = "polytope"\n' + bad), encoding="utf-8")
+        with pytest.raises(InputError, match=match):
+            read_system_file(f)
+
+
+@pytest.mark.slow
+def test_flexible_attitude_from_the_cli_designs(capsys):
+    import json
+    from pathlib import Path
+
+    from hinfnav.cli import main
+
+    root = Path(__file__).resolve().parents[1]
+    rc = main(["design", "--system", str(root / "examples" / "flexible_attitude_20pct.toml"), "--form", "observer",
+               "--solver", "CLARABEL", "--json"])
+    out = capsys.readouterr()
+    assert rc == 0, out.err
+    rep = json.loads(out.out)
+    assert rep["form"] == "observer" and rep["verified_worst_norm"] <= rep["gamma"] and "cells" in rep["covers"]
