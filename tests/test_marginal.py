@@ -61,8 +61,20 @@ def test_uncertainty_on_an_integrator_is_refused_naming_the_states():
 
 
 def test_general_form_on_the_open_loop_plant_says_why():
+    poly = flexible_attitude()
     with pytest.raises(UnstablePlantError, match="form='observer'"):
-        hn.synthesize_polytopic(flexible_attitude(), form="general")
+        hn.synthesize_polytopic(poly, form="general")
+    # hand-built proof that no general-form filter exists: u with uᵀA = uᵀ (the attitude integrator) makes [u; 0] a
+    # left eigenvector of Ā = [[A, 0], [B_F C, A_F]] at 1 for EVERY filter, so Ā is never Schur stable and (E1)
+    # (which implies Āᵀ P Ā < P) has no solution; checked on random filters to round-off (closed form)
+    A = poly.vertices[0].A
+    u = np.array([0.0, 1.0, 0.0, 0.0])
+    assert np.allclose(u @ A, u, atol=1e-15)
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        A_F, B_F = rng.standard_normal((4, 4)), rng.standard_normal((4, 1))
+        Abar = np.block([[A, np.zeros((4, 4))], [B_F @ poly.vertices[0].C, A_F]])
+        assert np.allclose(np.concatenate([u, np.zeros(4)]) @ Abar, np.concatenate([u, np.zeros(4)]), atol=1e-14)
 
 
 def test_cells_from_parameter_splits_cover_the_box():
