@@ -240,3 +240,18 @@ def test_flexible_attitude_from_the_cli_designs(capsys):
     assert rc == 0, out.err
     rep = json.loads(out.out)
     assert rep["form"] == "observer" and rep["verified_worst_norm"] <= rep["gamma"] and "cells" in rep["covers"]
+
+
+@pytest.mark.slow
+def test_flexible_attitude_closed_loop_20pct_general_form_on_cells(tmp_path):
+    poly = flexible_attitude_closed_loop(splits=8)
+    res = hn.synthesize_polytopic(poly, form="general", lyapunov="parameter-dependent", solver="CLARABEL")
+    assert res.form == "general" and "each cell" in res.covers
+    rng = np.random.default_rng(5)
+    eye = np.eye(poly.n_vertices)
+    alphas = [eye[i] for i in range(poly.n_vertices)]
+    for cell in poly.cells:
+        alphas += list(rng.dirichlet(np.ones(len(cell)), size=3) @ eye[list(cell)])
+    assert _full_error_response_worst(poly, alphas, res.A_F, res.B_F, res.C_F, poly.dt) <= res.gamma * (1 + 1e-9)
+    rep = hn.recertify(save_design(res, poly, tmp_path / "clgen.json"))
+    assert rep["ok"], rep["reasons"]

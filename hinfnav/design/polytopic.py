@@ -44,6 +44,7 @@ from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
 from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
+from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
 from .result import FilterDesign, SynthesisResult
 
@@ -150,6 +151,8 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
         return _certify_h2(system, A_F, B_F, C_F, witness, form)
     if "T" in witness:  # observer form on the augmented error system [x_s; e] (issue 30)
         return certify_augmented(system, A_F, B_F, C_F, witness)
+    if "cells" in witness:  # general form, one slack and Lyapunov matrices per cell (issue 30)
+        return certify_cells_general(system, A_F, B_F, C_F, witness)
     P_list, G = witness["P"], np.asarray(witness["G"], dtype=float)
     if len(P_list) != system.n_vertices:
         raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
@@ -290,6 +293,8 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     if form == "observer" and objective == "hinf" and needs_augmented(system):
         return _augmented_result(system, lyapunov, solvers, alphas, t0)
     _check(system, form)
+    if form == "general" and objective == "hinf" and system.cells:
+        return _cells_result(system, lyapunov, solvers, t0)
     verts = _vertex_tuples(system)
     log, statuses, best, seconds = [], [], None, 0.0
     for slv in solvers:
@@ -366,6 +371,23 @@ def _augmented_result(system, lyapunov, solvers, alphas, t0):
         covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"
                                         if system.cells else "in the simplex")
         + f"; the error system is augmented with the states the uncertainty reads ({states})",
+        witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
+        total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
+        objective="hinf")
+
+
+def _cells_result(system, lyapunov, solvers, t0):
+    """General form on a polytope with cells: :mod:`.cells` (internal)."""
+    out = design_cells_general(system, lyapunov, solvers)
+    if not out["ok"]:
+        raise CertificationError("no general-form solution of (E1) on the cells passed certification (solver status: "
+                                 + "; ".join(out["statuses"]) + "): " + " | ".join(out["log"]))
+    norms, k = out["norms"], int(np.argmax(out["norms"]))
+    return PolytopicResult(
+        A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=out["lmi_gamma"],
+        verified_norm=float(norms[k]), sample_norms=norms, alphas=out["alphas"], worst_sample=k,
+        spectral_radius=float(np.max(out["radii"])), lyapunov=lyapunov, form="general",
+        covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"),
         witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
         total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
         objective="hinf")
