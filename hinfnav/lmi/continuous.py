@@ -45,7 +45,8 @@ from numpy.typing import ArrayLike
 from ..analysis.certificates import schur_gamma
 from .solve import solver_kwargs
 
-__all__ = ["continuous_brl_matrix", "continuous_pd_matrix", "robust_hinf_continuous", "certify_continuous"]
+__all__ = ["continuous_brl_matrix", "continuous_pd_matrix", "robust_hinf_continuous", "certify_continuous",
+           "solve_continuous_observer"]
 
 
 def continuous_brl_matrix(P, A, B, C, D, gamma2, bmat: Callable[..., Any] = np.block):
@@ -137,3 +138,62 @@ def certify_continuous(vertices: Sequence[Sequence[ArrayLike]], witness: dict[st
             idx = np.arange(n, n + m)
         worst = max(worst, schur_gamma(M0, idx)[0])
     return worst
+
+
+def solve_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], T: ArrayLike, nominal: Sequence[ArrayLike],
+                              eps: float, solver: str = "CLARABEL", margin: float = 1e-9,
+                              accuracy: float = 1e-9) -> dict[str, Any]:
+    """Minimize γ² subject to (C2) on the augmented error ζ = [x_s; e] of an observer, G = ε F (see design.continuous).
+
+    ``F = [[F₁₁, 0], [F₂₁, F₂₂]]``, ``F̂ = F₂₂ B_F``; returns ``P`` (per vertex), ``F``, ``G``, ``B_F``, ``gamma``.
+    """
+    T = np.atleast_2d(np.asarray(T, dtype=float))
+    A0, C0, L0 = (np.atleast_2d(np.asarray(M, dtype=float)) for M in nominal)
+    ns, n = T.shape
+    m = C0.shape[0]
+    N = ns + n
+    F11, F21, F22 = cp.Variable((ns, ns)), cp.Variable((n, ns)), cp.Variable((n, n))
+    Fh = cp.Variable((n, m))
+    F = cp.bmat([[F11, np.zeros((ns, n))], [F21, F22]]) if ns else F22
+    g = cp.Variable()
+    cons, Ps = [], []
+    for A, B, C, D, L in _as_five(vertices):
+        As, dA, dC = T @ A @ T.T, (A - A0) @ T.T, (C - C0) @ T.T
+        q = D.shape[1]
+        if ns:
+            FA = cp.bmat([[F11 @ As, np.zeros((ns, n))], [F21 @ As + F22 @ dA + Fh @ dC, F22 @ A0 + Fh @ C0]])
+            FB = cp.bmat([[F11 @ (T @ B), np.zeros((ns, q))], [F21 @ (T @ B) + F22 @ B, Fh @ D]])
+        else:
+            FA, FB = F22 @ A0 + Fh @ C0, cp.hstack([F22 @ B, Fh @ D])
+        Cb = np.hstack([(L - L0) @ T.T, L0])
+        P = cp.Variable((N, N), symmetric=True)
+        Ps.append(P)
+        p, k = Cb.shape[0], FB.shape[1]
+        Z = np.zeros
+        M = cp.bmat([
+            [FA + FA.T, P - F + eps * FA.T, FB, Cb.T],
+            [P - F.T + eps * FA, -eps * (F + F.T), eps * FB, Z((N, p))],
+            [FB.T, eps * FB.T, -g * np.eye(k), Z((k, p))],
+            [Cb, Z((p, N)), Z((p, k)), -np.eye(p)],
+        ])
+        cons += [P >> margin * np.eye(N), 0.5 * (M + M.T) << -margin * np.eye(M.shape[0])]
+    prob = cp.Problem(cp.Minimize(g), cons)
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
+        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            return {"status": f"solver error ({exc})", "gamma": float("nan"), "seconds": time.perf_counter() - start}
+    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
+           "gamma": float(np.sqrt(max(g.value, 0.0))) if g.value is not None else float("nan")}
+    if F22.value is None or any(P.value is None for P in Ps) or not np.linalg.cond(F22.value) < 1e14:
+        return out
+    Fv = np.array(F.value)
+    out.update(P=[0.5 * (P.value + P.value.T) for P in Ps], F=Fv, G=eps * Fv,
+               B_F=np.linalg.solve(F22.value, Fh.value))
+    return out
+
+
+def _as_five(vertices):
+    return [tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in v) for v in vertices]
