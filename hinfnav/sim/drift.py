@@ -1,7 +1,7 @@
 """A polytopic plant whose parameter drifts, with a fixed linear filter: the error and its energy bound.
 
 For a filter certified at level γ (H∞, zero initial state), the error
-``e = z − z_f`` obeys the energy inequality
+``e = z − z_f`` obeys the energy inequality::
 
     Σₖ₌₀ᴷ |e(k)|²  ≤  γ² Σₖ₌₀ᴷ (|w(k)|² + |v(k)|²)        for every K
 
