@@ -46,7 +46,8 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .systems import (
         hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
         position_from_range_angles, range_angles, RangeAzimuthElevation, Saturated, StateSpec,
-        two_mass_spring, UncertainSystem, uncertainty_F, uncertainty_structure,
+        two_mass_spring, UncertainSystem, uncertainty_F, uncertainty_structure, polytope_from_parameters,
+        polytope_coverage, flexible_attitude, flexible_attitude_closed_loop,
     )
     from .noise import make_noise, NOISE_NAMES
     from .analysis import (
@@ -123,6 +124,10 @@ __all__ = [
     "UncertainSystem",
     "PolytopicSystem",
     "two_mass_spring",
+    "polytope_from_parameters",
+    "polytope_coverage",
+    "flexible_attitude",
+    "flexible_attitude_closed_loop",
     "hill_matrices",
     "uncertainty_structure",
     "uncertainty_F",

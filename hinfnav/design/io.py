@@ -108,6 +108,8 @@ def design_to_dict(result, system, *, options=None, extra=None):
                     method="minimize", objective=result.objective)
         sysd = {"kind": "polytope", "dt": dt, "labels": list(system.labels),
                 "vertices": [{k: getattr(v, k).tolist() for k in MATRIX_KEYS} for v in system.vertices]}
+        if system.cells:
+            sysd["cells"] = [list(c) for c in system.cells]
         witness = {k: _plain(v) for k, v in result.witness.items()}
     else:
         cert.update(
@@ -171,7 +173,8 @@ def design_from_dict(d, path="<dict>"):
 
 def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
     verts = [UncertainSystem(*(_matrix(v, k, path) for k in MATRIX_KEYS), dt=float(s["dt"])) for v in s["vertices"]]
-    system = PolytopicSystem(tuple(verts), float(s["dt"]), tuple(s.get("labels", ())))
+    system = PolytopicSystem(tuple(verts), float(s["dt"]), tuple(s.get("labels", ())),
+                             tuple(tuple(c) for c in s.get("cells", ())))
     w = d.get("witness") or {}
     result = PolytopicResult(
         A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),

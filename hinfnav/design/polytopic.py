@@ -43,6 +43,8 @@ from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gam
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
+from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
+from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
 from .result import FilterDesign, SynthesisResult
 
@@ -147,6 +149,10 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
     """
     if "W" in witness:
         return _certify_h2(system, A_F, B_F, C_F, witness, form)
+    if "T" in witness:  # observer form on the augmented error system [x_s; e] (issue 30)
+        return certify_augmented(system, A_F, B_F, C_F, witness)
+    if "cells" in witness:  # general form, one slack and Lyapunov matrices per cell (issue 30)
+        return certify_cells_general(system, A_F, B_F, C_F, witness)
     P_list, G = witness["P"], np.asarray(witness["G"], dtype=float)
     if len(P_list) != system.n_vertices:
         raise InputError(f"the witness has {len(P_list)} Lyapunov matrices for {system.n_vertices} vertices")
@@ -187,14 +193,18 @@ def _certify_h2(system, A_F, B_F, C_F, witness, form):
     return float("inf"), [float("inf")] * system.n_vertices
 
 
-def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None, objective="hinf"):
+def sampled_norms(system, A_F, B_F, C_F, form="general", alphas=None, objective="hinf", witness=None):
     """H∞ norms of the error system at convex weights ``alphas`` (default: :func:`simplex_grid`).
 
-    Returns ``(norms, spectral_radii, alphas)``.
+    A ``witness`` with ``T`` (observer form whose uncertainty reads part of
+    the state) selects the augmented error system of
+    :mod:`hinfnav.analysis.marginal`. Returns ``(norms, spectral_radii, alphas)``.
     """
     if alphas is None:
         alphas = simplex_grid(system.n_vertices, points=41 if system.n_vertices <= 2 else 200,
                               n_random=0 if system.n_vertices <= 2 else 20)
+    if witness is not None and "T" in witness:
+        return (*augmented_norms(system, A_F, B_F, C_F, witness, alphas), np.asarray(alphas))
     norms, radii = [], []
     for a in alphas:
         s = system.at(a)
@@ -275,12 +285,16 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     if not np.any([np.any(v.L) for v in system.vertices]):
         raise InputError("L is zero at every vertex: the estimated signal z = L x is identically 0, so there is "
                          "nothing to estimate (the zero filter is exact); give a nonzero L")
-    _check(system, form)
     N = system.n_vertices
     if grid_points is None:
         alphas = simplex_grid(N, points=41 if N <= 2 else 200, n_random=0 if N <= 2 else 20, seed=seed)
     else:
         alphas = simplex_grid(N, points=as_int_at_least("grid_points", grid_points, 1), n_random=0, seed=seed)
+    if form == "observer" and objective == "hinf" and needs_augmented(system):
+        return _augmented_result(system, lyapunov, solvers, alphas, t0)
+    _check(system, form)
+    if form == "general" and objective == "hinf" and system.cells:
+        return _cells_result(system, lyapunov, solvers, t0)
     verts = _vertex_tuples(system)
     log, statuses, best, seconds = [], [], None, 0.0
     for slv in solvers:
@@ -333,6 +347,50 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
         system=system, objective=objective,
     )
+
+
+def _augmented_result(system, lyapunov, solvers, alphas, t0):
+    """Observer form when A, C or L vary: the augmented error system [x_s; e] (:mod:`.augmented`; internal)."""
+    out = design_augmented_observer(system, lyapunov, solvers, alphas if not system.cells else None)
+    alphas = out["alphas"]
+    if not out["ok"]:
+        if all(any(s.endswith(st) for st in INFEASIBLE) for s in out["statuses"]):
+            raise InfeasibleLMIError(
+                "no solver found a solution of the extended LMI (E1) on the augmented error system [x_s; e] (observer "
+                "form, the uncertainty reading the states " + ", ".join(f"x[{j}]" for j in out["part"].states)
+                + "); solver status: " + "; ".join(out["statuses"]) + ". With lyapunov='common' try "
+                "'parameter-dependent' (α constant in time); otherwise reduce the uncertainty.")
+        raise CertificationError("no solution of the augmented observer LMI passed certification: "
+                                 + " | ".join(out["log"] or out["statuses"]))
+    norms, k = out["norms"], int(np.argmax(out["norms"]))
+    states = ", ".join(f"x[{j}]" for j in out["part"].states)
+    return PolytopicResult(
+        A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=out["lmi_gamma"],
+        verified_norm=float(norms[k]), sample_norms=norms, alphas=alphas, worst_sample=k,
+        spectral_radius=float(np.max(out["radii"])), lyapunov=lyapunov, form="observer",
+        covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"
+                                        if system.cells else "in the simplex")
+        + f"; the error system is augmented with the states the uncertainty reads ({states})",
+        witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
+        total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
+        objective="hinf")
+
+
+def _cells_result(system, lyapunov, solvers, t0):
+    """General form on a polytope with cells: :mod:`.cells` (internal)."""
+    out = design_cells_general(system, lyapunov, solvers)
+    if not out["ok"]:
+        raise CertificationError("no general-form solution of (E1) on the cells passed certification (solver status: "
+                                 + "; ".join(out["statuses"]) + "): " + " | ".join(out["log"]))
+    norms, k = out["norms"], int(np.argmax(out["norms"]))
+    return PolytopicResult(
+        A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=out["lmi_gamma"],
+        verified_norm=float(norms[k]), sample_norms=norms, alphas=out["alphas"], worst_sample=k,
+        spectral_radius=float(np.max(out["radii"])), lyapunov=lyapunov, form="general",
+        covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"),
+        witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
+        total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
+        objective="hinf")
 
 
 def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):

@@ -89,7 +89,7 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
                                                                result.witness, result.form)[0]}
         alphas = result.alphas if np.size(result.alphas) else None
         norms, radii, _ = sampled_norms(system, result.A_F, result.B_F, result.C_F, result.form, alphas,
-                                        result.objective)
+                                        result.objective, witness=result.witness)
     else:
         levels = _lmi_levels(result, system)
         if "G" in result.variables:

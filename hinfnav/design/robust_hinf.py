@@ -233,7 +233,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
         ``"general"`` (default): LMI (20) as in the paper, any full-order
         filter (12). ``"observer"``: the filter is constrained to a
         predictor observer, ``C_F = −L`` and ``A_F = A + B_F C`` (see Notes);
-        needs ``L`` square and invertible.
+        any output ``L`` (partial, mixing states; not zero).
     options : SolverOptions, optional
         Every solver choice (solvers and their order, method, margins,
         tolerances, bisection, polishing, state scaling); default
@@ -250,7 +250,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     ------
     InputError
         Mismatched shapes, non-finite entries, bad options (an unknown
-        ``form``, or ``form="observer"`` with ``L`` not square and invertible).
+        ``form``, or ``L = 0``).
     UnstablePlantError
         ``A + H F E`` is not Schur stable at some sample (no finite γ).
     InfeasibleLMIError
@@ -322,9 +322,10 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     variables are scaled back exactly and the certificate is evaluated with
     the original data.
 
-    The derivation itself only uses ``C_F = −L`` (the filter state is
-    always a full state estimate); ``L`` is required square and invertible
-    so that ``x̂ = C_F x_f`` is that estimate, as in the paper (L = I).
+    The derivation only uses ``C_F = −L``: the filter state is always a full
+    state estimate ``x̂ = −x_f`` and ``z_f = L x̂``, for any output L (square
+    or not, partial or mixing states); only ``L = 0`` is refused (nothing to
+    estimate).
     """
     t_start = time.perf_counter()
     system, dt_value = system_argument("synthesize", system, matrices, legacy)
@@ -341,20 +342,8 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     if not isinstance(form, str):
         raise InputError(f"form must be a string, one of {', '.join(FORMS)}; got {form!r}")
     form = as_choice("form", form, FORMS)
-    if form == "observer":
-        n_state, l_out = system.A.shape[0], system.L.shape[0]
-        if l_out != n_state:
-            raise InputError(
-                f"form='observer' needs the filter to estimate the whole state: L must be square and invertible, "
-                f"got L of shape {l_out}x{n_state}"
-            )
-        condL = np.linalg.cond(system.L)
-        if not condL < 1e12:
-            raise InputError(
-                f"form='observer' needs L square and invertible (C_F = −L); L is singular (cond {condL:.3g})"
-            )
     solvers = list(options.solvers)
-    if not np.any(system.L):
+    if system.L.size == 0 or not np.any(system.L):
         raise InputError("L is zero: the estimated signal z = L x is identically 0, so there is nothing to estimate "
                          "(the zero filter is exact); give a nonzero L")
     if system.H is not None and not (np.any(system.H) and np.any(system.E)):

@@ -117,7 +117,7 @@ def observer_lmi_matrix(A: ArrayLike, B: ArrayLike, C: ArrayLike, D: ArrayLike, 
     Parameters
     ----------
     A, B, C, D, L, H, E
-        As in :func:`lmi20_matrix` (``L`` square); ``H = None`` for the
+        As in :func:`lmi20_matrix` (any ``L``); ``H = None`` for the
         nominal LMI.
     X, S : ndarray or cvxpy expression, shape (n, n)
     Bbar_F : shape (n, m)

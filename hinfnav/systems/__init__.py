@@ -30,6 +30,8 @@ from .measurements import (
 from .files import read_system_file
 from .planar import ConvertedRangeBearing, RangeBearing
 from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
+from .parametric import Coverage, polytope_coverage, polytope_from_parameters
+from .flexible import flexible_attitude, flexible_attitude_closed_loop, flexible_attitude_matrices
 from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 from .timed import TimedReadings, TimedSystem, merge_readings, read_timed_csv
@@ -65,6 +67,12 @@ __all__ = [
     "PolytopicSystem",
     "simplex_grid",
     "two_mass_spring",
+    "polytope_from_parameters",
+    "polytope_coverage",
+    "Coverage",
+    "flexible_attitude",
+    "flexible_attitude_closed_loop",
+    "flexible_attitude_matrices",
     "read_system_file",
     "TimedSystem",
     "TimedReadings",

@@ -15,7 +15,9 @@ Format (nested lists of numbers; ``x⁺ = A x + B w``, ``y = C x + D v``,
     H = [[0.0], [0.01]]
     E = [[1.0, 0.0]]
     # or: kind = "polytope" and [[uncertainty.vertices]] tables, each giving
-    # any of A, B, C, D, L that differ from [nominal]
+    # any of A, B, C, D, L that differ from [nominal]; optional
+    # cells = [[0, 1, 2, 3], [2, 3, 4, 5]]: the family is the union of the
+    # hulls of these groups of vertices (0-based), not the hull of all
 
 Every error names the key in the file.
 """
@@ -108,7 +110,14 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
                     raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
                                      f"{', '.join(MATRIX_KEYS)}")
             verts = [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
-            return PolytopicSystem.from_matrices(mats, verts, dt)
+            poly = PolytopicSystem.from_matrices(mats, verts, dt)
+            cells = unc.get("cells")  # optional: groups of vertex indices; the family is the union of their hulls
+            if cells is None:
+                return poly
+            if not (isinstance(cells, list) and cells and all(isinstance(c, list) and c and
+                                                              all(isinstance(i, int) for i in c) for c in cells)):
+                raise InputError("[uncertainty] key 'cells' must be a list of lists of vertex indices (0-based)")
+            return PolytopicSystem(poly.vertices, poly.dt, poly.labels, tuple(tuple(c) for c in cells))
         raise InputError(f"[uncertainty] key 'kind' must be \"norm-bounded\" or \"polytope\"; got {kind!r}")
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None

@@ -41,11 +41,19 @@ class PolytopicSystem:
         Sampling time, s.
     labels : tuple of str
         One label per vertex.
+    cells : tuple of tuple of int, optional
+        When given, the family is the union of the hulls of these groups of
+        vertices (e.g. sub-boxes of a parameter range,
+        :func:`hinfnav.systems.polytope_from_parameters` with ``splits``), not
+        the hull of all of them; a design may certify cell by cell (the
+        observer form on a marginally stable plant does), or certify the
+        whole hull, which contains the union.
     """
 
     vertices: tuple
     dt: float = 1.0
     labels: tuple = ()
+    cells: tuple = ()
 
     def __post_init__(self):
         verts = tuple(self.vertices)
@@ -61,8 +69,15 @@ class PolytopicSystem:
         labels = tuple(str(s) for s in self.labels) or tuple(f"vertex {i}" for i in range(len(verts)))
         if len(labels) != len(verts):
             raise InputError(f"labels must have one entry per vertex ({len(verts)}); got {len(labels)}")
+        cells = tuple(tuple(int(i) for i in c) for c in self.cells)
+        for c in cells:
+            if not c or min(c) < 0 or max(c) >= len(verts):
+                raise InputError(f"cells must hold vertex indices 0 … {len(verts) - 1}; got {c!r}")
+        if cells and set().union(*cells) != set(range(len(verts))):
+            raise InputError("cells must use every vertex")
         object.__setattr__(self, "vertices", verts)
         object.__setattr__(self, "labels", labels)
+        object.__setattr__(self, "cells", cells)
         object.__setattr__(self, "dt", as_positive("dt", self.dt))
 
     @classmethod
