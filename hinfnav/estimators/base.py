@@ -441,6 +441,11 @@ class Estimator:
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
+        if getattr(self, "gate", None) is not None and backend != "numpy":  # a gate runs on the NumPy path only
+            if backend == "numba":
+                raise InputError(f"backend='numba' is not available for filter {self.name!r}: its gate runs on the "
+                                 "NumPy path only; use backend='numpy' or 'auto'")
+            backend = "numpy"
         if select_backend(self, backend, keys) == "numba":
             xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
             if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says

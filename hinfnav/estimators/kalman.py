@@ -50,6 +50,7 @@ from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
+from .gate import ChiSquareGate
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -89,6 +90,24 @@ class KalmanCore(KalmanCorrection, Estimator):
     transient_keys = _TRANSIENT
     #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
     R_of_reading = None
+    _gate = None
+
+    @property
+    def gate(self) -> ChiSquareGate | None:
+        """The χ² innovation gate every reading passes before the correction (None: no gate).
+
+        A :class:`~hinfnav.estimators.gate.ChiSquareGate`: rejected channels are removed from the
+        update as missing ones are, its recovery policy keeps a run of rejections from locking the
+        filter out, and each step reports ``gate_rejected`` … (see :mod:`hinfnav.estimators.gate`).
+        A gated filter carries one covariance per run and runs on the NumPy path.
+        """
+        return self._gate
+
+    @gate.setter
+    def gate(self, value: ChiSquareGate | None) -> None:
+        if value is not None and not isinstance(value, ChiSquareGate):
+            raise InputError(f"gate must be a hinfnav ChiSquareGate or None; got {type(value).__name__}")
+        self._gate = value
 
     @property
     def n_cov(self) -> int:
@@ -153,6 +172,11 @@ class KalmanCore(KalmanCorrection, Estimator):
         """Extra items to keep after a prediction to P(k+1|k) (none here; a gain freeze keeps its record)."""
         return {}
 
+    def carried(self, diagnostics: dict[str, Any]) -> dict[str, Any]:
+        """Items of the correction's diagnostics to keep in ``FilterState.extra`` for the next reading (none here;
+        the noise-adaptive filter keeps its α, β)."""
+        return {}
+
     def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
 
@@ -180,7 +204,7 @@ class KalmanCore(KalmanCorrection, Estimator):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
         x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
         x = np.broadcast_to(x0, (runs, x0.size)).copy()
-        if not self.shares_covariance:
+        if not self.shares_covariance or self._gate is not None:  # a gate's rejections depend on the data
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
@@ -206,6 +230,12 @@ class KalmanCore(KalmanCorrection, Estimator):
                                                     mask=mask)
             diag_prior.update(d_hook)
             extra.update(e_hook)
+        shown = mask  # the channels the reading has (a rejected channel's innovation is still reported)
+        if self._gate is not None:
+            P, mask, d_gate, e_gate = self._gate.screen(P, H, self.R if R_k is None else R_k, innovation, mask,
+                                                        state.extra.get("gate_count"))
+            diag_prior.update(d_gate)
+            extra.update(e_gate)
         try:
             if mask is None:
                 x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
@@ -222,7 +252,8 @@ class KalmanCore(KalmanCorrection, Estimator):
         if self.refuse_nonfinite and not (np.all(np.isfinite(x_post)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         extra.update(self.after_update(state, x_post))
-        diag = dict(diag_prior, **diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
+        extra.update(self.carried(diag))
+        diag = dict(diag_prior, **diag, innovation=innovation if shown is None else np.where(shown, innovation, np.nan))
         diag.update(self.update_diagnostics(x_post))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(extra, prior=(x, P)))
         if self.output == "filtered":
