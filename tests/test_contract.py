@@ -101,6 +101,9 @@ def test_every_paper_filter_is_registered():
     for sc in (SCENARIO, SHI):
         assert {"ukf", "stekf", "huber_stekf"} <= set(registered_estimators(sc))
     assert not {"stekf", "huber_stekf"} & set(registered_estimators(ATTITUDE) + registered_estimators(YANG))
+    # the robust filters of issue 33 (Student-t, VB noise-adaptive, maximum correntropy) on every Kalman model
+    for sc in (SCENARIO, SHI):
+        assert {"model_stkf", "model_vbakf", "model_mckf"} <= set(registered_estimators(sc))
 
 
 def test_yang2020_registered_for_the_paper_and_only_there():

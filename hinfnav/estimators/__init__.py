@@ -20,6 +20,9 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .recursive_hinf import RecursiveHInfinityFilter
     from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
     from .lti import LTIFilter
+    from .variational import NoiseAdaptiveFilter, StudentTFilter
+    from .correntropy import CorrentropyFilter
+    from .gate import ChiSquareGate, gate_report, gated
     from .sigma_point import SigmaPointFilter
     from .registry import build_estimator, estimator_entry, register_estimator, registered_estimators
 
@@ -57,6 +60,12 @@ __all__ = [
     "AugmentedInputKF",
     "AugmentedInputSTKF",
     "AugmentedInputAdaptiveKF",
+    "StudentTFilter",
+    "NoiseAdaptiveFilter",
+    "CorrentropyFilter",
+    "ChiSquareGate",
+    "gate_report",
+    "gated",
     "register_estimator",
     "build_estimator",
     "registered_estimators",
