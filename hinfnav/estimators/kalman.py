@@ -104,9 +104,12 @@ class KalmanCore(KalmanCorrection, Estimator):
         return self._gate
 
     @gate.setter
-    def gate(self, value: ChiSquareGate | None) -> None:
+    def gate(self, value: ChiSquareGate | dict | None) -> None:
+        if isinstance(value, dict):  # the gate's parameters (a campaign cell's options are JSON)
+            value = ChiSquareGate(**value)
         if value is not None and not isinstance(value, ChiSquareGate):
-            raise InputError(f"gate must be a hinfnav ChiSquareGate or None; got {type(value).__name__}")
+            raise InputError(f"gate must be a hinfnav ChiSquareGate, the dict of its parameters or None; got "
+                             f"{type(value).__name__}")
         self._gate = value
 
     @property

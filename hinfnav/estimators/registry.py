@@ -224,11 +224,22 @@ def estimator_entry(name: str) -> _Entry:
 
 @scenario_moved("name", "scenario", was=str)
 def build_estimator(scenario: Any, name: str, **options: Any) -> Estimator:
-    """Build the estimator registered as ``name`` for ``scenario``."""
+    """Build the estimator registered as ``name`` for ``scenario``.
+
+    ``options`` go to its builder, except ``gate``: a
+    :class:`~hinfnav.estimators.gate.ChiSquareGate` or the dict of its parameters (a campaign's cell
+    options), set on the filter built (a filter of the Kalman core).
+    """
     entry = estimator_entry(name)
     why = fit_reason(scenario, name)
     if why is not None:
         fitting = ", ".join(registered_estimators(scenario))
         raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "
                          f"these do: {fitting}")
-    return entry.builder(scenario, **options)
+    gate = options.pop("gate", None)
+    est = entry.builder(scenario, **options)
+    if gate is not None:  # a χ² innovation gate on a filter of the Kalman core (hinfnav.estimators.gate)
+        if not hasattr(type(est), "gate"):
+            raise InputError(f"gate: filter {name!r} is not of the Kalman core and takes no gate")
+        est.gate = gate  # a dict is the gate's parameters (the filter's setter builds it)
+    return est
