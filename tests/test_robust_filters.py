@@ -76,19 +76,18 @@ def ref_student_t(z, h, jac, R, omega, nu, N, tau):
     for k in range(z.shape[0]):
         xp, Pp = _predict(x, P, k)
         H, r = jac(xp), z[k] - h(xp)
-        E_xi = E_lam = 1.0
-        xk, Pk = xp, Pp
+        xk, Pk = xp, Pp  # initialisation: x̂⁽⁰⁾ = x̂⁻, P⁽⁰⁾ = P⁻
         for _ in range(N):
             x_old = xk
-            Pt, Rt = Pp / E_xi, R / E_lam
+            A = np.outer(xk - xp, xk - xp) + Pk  # q(ξ) given q⁽ⁱ⁾(x)
+            E_xi = (omega + n) / (omega + np.trace(A @ np.linalg.inv(Pp)))
+            e = r - H @ (xk - xp)  # q(λ) given q⁽ⁱ⁾(x)
+            B = np.outer(e, e) + H @ Pk @ H.T
+            E_lam = (nu + m) / (nu + np.trace(B @ np.linalg.inv(R)))
+            Pt, Rt = Pp / E_xi, R / E_lam  # q⁽ⁱ⁺¹⁾(x)
             K = Pt @ H.T @ np.linalg.inv(H @ Pt @ H.T + Rt)
             xk = xp + K @ r
             Pk = Pt - K @ H @ Pt
-            A = np.outer(xk - xp, xk - xp) + Pk
-            E_xi = (omega + n) / (omega + np.trace(A @ np.linalg.inv(Pp)))
-            e = r - H @ (xk - xp)
-            B = np.outer(e, e) + H @ Pk @ H.T
-            E_lam = (nu + m) / (nu + np.trace(B @ np.linalg.inv(R)))
             if np.linalg.norm(xk - x_old) / np.linalg.norm(xk) <= tau:
                 break
         x, P = xk, Pk

@@ -14,23 +14,28 @@ Student-t with scale matrices Q, R and degrees of freedom ω (process) and ν
 (measurement). The predicted density is approximated as St(x̂⁻, P⁻, ω) with the
 nominal ``P⁻ = F P Fᵀ + Q`` and the likelihood as St(y; h(x), R, ν); each is a Gaussian
 scale mixture with Gamma-distributed scales ξ (prior) and λ (likelihood), and the
-variational fixed point is, from E⁽⁰⁾[ξ] = E⁽⁰⁾[λ] = 1 (i = 0 … N−1),
+variational iteration is, from q⁽⁰⁾(x) the prior (x̂⁽⁰⁾ = x̂⁻, P⁽⁰⁾ = P⁻; i = 0 … N−1),
+first the scales given q⁽ⁱ⁾(x), then q⁽ⁱ⁺¹⁾(x) given the scales:
 
 .. math::
 
-    \\tilde P = P^-/E^{(i)}[\\xi], \\quad \\tilde R = R/E^{(i)}[\\lambda], \\quad
+    E^{(i+1)}[\\xi] = \\frac{\\omega + n}{\\omega + \\operatorname{tr}\\{A P^{-,-1}\\}}, \\quad
+    A = (\\hat x^{(i)} - \\hat x^-)(\\cdot)^T + P^{(i)},
+
+    E^{(i+1)}[\\lambda] = \\frac{\\nu + m}{\\nu + \\operatorname{tr}\\{B R^{-1}\\}}, \\quad
+    B = (\\nu_k - H(\\hat x^{(i)} - \\hat x^-))(\\cdot)^T + H P^{(i)} H^T,
+
+    \\tilde P = P^-/E^{(i+1)}[\\xi], \\quad \\tilde R = R/E^{(i+1)}[\\lambda], \\quad
     K = \\tilde P H^T (H \\tilde P H^T + \\tilde R)^{-1},
 
     \\hat x^{(i+1)} = \\hat x^- + K \\nu_k, \\quad P^{(i+1)} = \\tilde P - K H \\tilde P,
 
-    E^{(i+1)}[\\xi] = \\frac{\\omega + n}{\\omega + \\operatorname{tr}\\{A P^{-,-1}\\}}, \\quad
-    A = (\\hat x^{(i+1)} - \\hat x^-)(\\cdot)^T + P^{(i+1)},
-
-    E^{(i+1)}[\\lambda] = \\frac{\\nu + m}{\\nu + \\operatorname{tr}\\{B R^{-1}\\}}, \\quad
-    B = (\\nu_k - H(\\hat x^{(i+1)} - \\hat x^-))(\\cdot)^T + H P^{(i+1)} H^T,
-
 stopped after N iterations or when ``‖x̂⁽ⁱ⁺¹⁾ − x̂⁽ⁱ⁾‖ / ‖x̂⁽ⁱ⁺¹⁾‖ ≤ τ``; x̂(k|k) and
-P(k|k) are the last iterate. On a nonlinear measurement H is the EKF's Jacobian at the
+P(k|k) are the last iterate. The order matters: the VB fixed point is not unique
+under an outlier, and starting from the prior (the scales first) lets the first
+iteration already see the innovation (measured on :mod:`hinfnav.papers.benchmark.huang2017`:
+the other order, the state first with E[ξ] = E[λ] = 1, lands on the fixed point that
+keeps the outlier and gives a larger error). On a nonlinear measurement H is the EKF's Jacobian at the
 prior and ``ν_k = y_k − h(x̂⁻)`` (Huang et al. treat the linear model; this is its
 first-order extension, as the package's Huber filter is).
 
@@ -139,23 +144,25 @@ class StudentTCorrection:
         Rinv = np.linalg.inv(R)
         HT = _swap(H)
         e_xi, e_lam = np.ones(runs), np.ones(runs)
-        dx = np.zeros_like(innovation, shape=(runs, n))
+        dx = np.zeros_like(innovation, shape=(runs, n))  # x̂⁽⁰⁾ = x̂⁻, P⁽⁰⁾ = P⁻
         P_post = np.array(P)
         active = np.ones(runs, dtype=bool)
         iters = np.zeros(runs, dtype=int)
         omega, nu = self.dof_process, self.dof_measurement
         for _ in range(self.iterations):
-            Pt = P / e_xi[:, None, None]
-            Rt = R / e_lam[:, None, None]
+            # q(ξ), q(λ) given q⁽ⁱ⁾(x) ...
+            A = dx[:, :, None] * dx[:, None, :] + P_post
+            e = innovation - (H @ dx[..., None])[..., 0]
+            B = e[:, :, None] * e[:, None, :] + H @ P_post @ HT
+            xi_new = (omega + n) / (omega + np.trace(A @ Pinv, axis1=-2, axis2=-1))
+            lam_new = (nu + m_used) / (nu + np.trace(B @ Rinv, axis1=-2, axis2=-1))
+            # ... then q⁽ⁱ⁺¹⁾(x) given them
+            Pt = P / xi_new[:, None, None]
+            Rt = R / lam_new[:, None, None]
             PHT = Pt @ HT
             K = _swap(np.linalg.solve(H @ PHT + Rt, _swap(PHT)))
             dx_new = (K @ innovation[..., None])[..., 0]
             P_new = Pt - K @ H @ Pt
-            A = dx_new[:, :, None] * dx_new[:, None, :] + P_new
-            e = innovation - (H @ dx_new[..., None])[..., 0]
-            B = e[:, :, None] * e[:, None, :] + H @ P_new @ HT
-            xi_new = (omega + n) / (omega + np.trace(A @ Pinv, axis1=-2, axis2=-1))
-            lam_new = (nu + m_used) / (nu + np.trace(B @ Rinv, axis1=-2, axis2=-1))
             change = relative_change(dx_new, dx, x_ref)
             dx = np.where(active[:, None], dx_new, dx)
             P_post = np.where(active[:, None, None], P_new, P_post)
