@@ -65,3 +65,18 @@ def test_bad_tuning_inputs_are_named():
         tune_consistency(build, {"s": -1.0}, x, y, u, X0)
     with pytest.raises(InputError, match="skip"):
         tune_consistency(build, {"s": 1.0}, x, y, u, X0, skip=50)
+
+
+def test_theta_of_the_recursive_hinf_filter_is_tuned_to_its_nees():
+    from hinfnav.estimators.recursive_hinf import RecursiveHInfinityFilter
+
+    # told the true Q and R, the recursive H∞ filter's θ > 0 inflates its P (NEES below n = 4, measured 3.71 at
+    # θ = 0.05); tuning θ alone on the NEES brings the average to n (the minimiser of J, here reachable: J → 0)
+    x, y, u = _cell()
+
+    def build(theta):
+        return RecursiveHInfinityFilter(SYSTEM, MEAS, theta=theta, P0=P0, Q=Q, R=R, uses_input=False)
+
+    res = tune_consistency(build, {"theta": 0.05}, x, y, u, X0, skip=15, use_nis=False, components=False, xatol=0.01)
+    np.testing.assert_allclose(res.nees, 4.0, rtol=0.01)
+    assert res.inside and 0 < res.scales["theta"] < 0.05 < build(0.05).theta_max()
