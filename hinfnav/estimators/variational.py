@@ -154,8 +154,9 @@ class StudentTCorrection:
             A = dx[:, :, None] * dx[:, None, :] + P_post
             e = innovation - (H @ dx[..., None])[..., 0]
             B = e[:, :, None] * e[:, None, :] + H @ P_post @ HT
-            xi_new = (omega + n) / (omega + np.trace(A @ Pinv, axis1=-2, axis2=-1))
-            lam_new = (nu + m_used) / (nu + np.trace(B @ Rinv, axis1=-2, axis2=-1))
+            # tr(A P⁻⁻¹) = Σ_ij A_ij (P⁻⁻¹)_ji without forming the product
+            xi_new = (omega + n) / (omega + np.einsum("rij,rji->r", A, np.broadcast_to(Pinv, A.shape)))
+            lam_new = (nu + m_used) / (nu + np.einsum("rij,rji->r", B, np.broadcast_to(Rinv, B.shape)))
             # ... then q⁽ⁱ⁺¹⁾(x) given them
             Pt = P / xi_new[:, None, None]
             Rt = R / lam_new[:, None, None]
