@@ -216,6 +216,10 @@ def plot_huang_comparison(table: pd.DataFrame, reference: str = "hbf"):
     ax1.barh(pos, arm, xerr=err, color=["C3" if f == reference else "C0" for f in table["filter"]], capsize=3)
     ax1.set_yticks(pos, table["filter"])
     ax1.set_xscale("log")
+    lo, hi = float(table["armse_low"].min()), float(table["armse_high"].max())
+    ticks = [v * 10.0**e for e in range(-1, 6) for v in (1, 2, 5) if lo / 1.5 <= v * 10.0**e <= hi * 1.5]
+    ax1.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax1.tick_params(axis="x", which="minor", labelbottom=False)  # the minor labels of a log axis overlap
     ax1.set_xlabel("position ARMSE, m (95 % interval)")
     ax1.invert_yaxis()
     ax2.barh(pos, table["us_per_step"], color="C2")
