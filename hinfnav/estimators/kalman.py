@@ -24,6 +24,11 @@ variants override small hooks:
   steady-gain freeze's record, :mod:`hinfnav.estimators.steady`);
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
+* :meth:`~KalmanCore.carried` — items of a correction's diagnostics kept for
+  the next reading (the noise-adaptive filter's α, β,
+  :mod:`hinfnav.estimators.variational`); :attr:`~KalmanCore.gate` — a χ²
+  innovation gate screening each reading before the correction
+  (:mod:`hinfnav.estimators.gate`);
 * :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
   unless the measurement's covariance depends on its reading (a converted
   range/angle measurement: ``J R Jᵀ`` at each reading);
