@@ -14,6 +14,7 @@ from hinfnav.estimators.correntropy import CorrentropyFilter
 from hinfnav.estimators.gate import ChiSquareGate, gate_report, gated
 from hinfnav.estimators.huber_filter import HuberFilter
 from hinfnav.estimators.kalman import ExtendedKalmanFilter
+from hinfnav.estimators.sigma_point import SigmaPointFilter
 from hinfnav.estimators.variational import NoiseAdaptiveFilter, StudentTFilter
 from hinfnav.systems.linear import LinearSystem
 from hinfnav.systems.measurements import LinearMeasurement
@@ -71,13 +72,14 @@ def test_rejects_a_25_m_spike_and_reports_it(per):
 
 
 @pytest.mark.parametrize("recovery", ["inflate", "reacquire"])
-def test_survives_a_5_minute_degradation(recovery):
+@pytest.mark.parametrize("cls", [ExtendedKalmanFilter, SigmaPointFilter])
+def test_survives_a_5_minute_degradation(recovery, cls):
     x, y = _track(jump_at=200)
     y = y.copy()
     rng = np.random.default_rng(3)
     y[:, 200:500] += 29.0 * rng.standard_normal((4, 300, 2))  # 5 minutes of 30 m readings (1 + 29² = 30² m²)
     u = np.zeros((4, 800, 1))
-    kf = ExtendedKalmanFilter(SYSTEM, MEAS, P0=P0)
+    kf = cls(SYSTEM, MEAS, P0=P0)
     locked = gated(kf, recovery=None).estimate(y, u, X0, diagnostics=True)
     hist = gated(kf, recovery=recovery).estimate(y, u, X0, diagnostics=True)
     # without recovery the filter locks out (measured in 3 of 4 runs): it rejects every one of the last 100 readings
@@ -97,7 +99,8 @@ def test_every_kalman_core_filter_takes_a_gate():
     y = y.copy()
     y[:, 60, 1] -= 25.0
     u = np.zeros((2, 150, 1))
-    for cls in (ExtendedKalmanFilter, HuberFilter, StudentTFilter, NoiseAdaptiveFilter, CorrentropyFilter):
+    for cls in (ExtendedKalmanFilter, HuberFilter, StudentTFilter, NoiseAdaptiveFilter, CorrentropyFilter,
+                SigmaPointFilter):
         est = cls(SYSTEM, MEAS, P0=P0)
         est.gate = ChiSquareGate()
         hist = est.estimate(y, u, X0, diagnostics=True)

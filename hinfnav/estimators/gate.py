@@ -52,7 +52,7 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .correction import drop_missing
 
-__all__ = ["ChiSquareGate", "GATE_KEYS", "RECOVERIES", "gate_report", "gated"]
+__all__ = ["ChiSquareGate", "GateOption", "GATE_KEYS", "RECOVERIES", "gate_report", "gated"]
 
 #: Recovery policies (see the module docstring).
 RECOVERIES = ("inflate", "reacquire", None)
@@ -99,30 +99,32 @@ class ChiSquareGate:
         dof = np.asarray(dof)
         return np.where(dof > 0, chi2.ppf(self.probability, np.maximum(dof, 1)), np.inf)
 
-    def screen(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
-               innovation: NDArray[np.float64], mask: NDArray[np.bool_] | None,
-               count: NDArray[np.int_] | None) -> tuple[NDArray[np.float64], NDArray[np.bool_] | None, dict, dict]:
-        """Test one reading of every run; return ``(P⁻, mask, diagnostics, extra)``.
+    def inflate(self, P: NDArray[np.float64], count: NDArray[np.int_] | None) -> NDArray[np.float64]:
+        """The prior covariance of the runs recovering by inflation (``count ≥ after``) times :attr:`inflation`."""
+        if self.recovery != "inflate" or count is None:
+            return P
+        recovering = np.asarray(count) >= self.after
+        if not recovering.any():
+            return P
+        factor = np.where(recovering, self.inflation, 1.0)
+        return np.broadcast_to(P, (factor.size,) + P.shape[-2:]) * factor[:, None, None]
 
-        ``P`` (runs, n, n) the prior (inflated on the recovering runs), ``mask`` the
-        channels to use ((runs, m); None: all), the diagnostics of the module
-        docstring and ``{"gate_count": …}`` to carry.
+    def decide(self, S: NDArray[np.float64], innovation: NDArray[np.float64], avail: NDArray[np.bool_],
+               count: NDArray[np.int_] | None) -> tuple[NDArray[np.bool_], dict, NDArray[np.int_]]:
+        """``(rejected, diagnostics, new count)`` of one reading per run.
+
+        ``S`` (runs, m, m) and ``innovation`` (runs, m) with the missing channels already removed
+        (innovation 0, unit diagonal in S), ``avail`` (runs, m) the channels the reading has.
         """
         runs, m = innovation.shape
-        avail = np.ones((runs, m), dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
         count = np.zeros(runs, dtype=int) if count is None else np.asarray(count)
         recovering = count >= self.after
-        if self.recovery == "inflate" and recovering.any():
-            factor = np.where(recovering, self.inflation, 1.0)
-            P = np.broadcast_to(P, (runs,) + P.shape[-2:]) * factor[:, None, None]
-        Pg, Hg, Rg, nu = drop_missing(P, H, R, innovation, None if mask is None else avail)
-        S = Hg @ Pg @ np.swapaxes(Hg, -1, -2) + Rg
         S = np.broadcast_to(S, (runs, m, m))
-        d2 = np.einsum("ri,ri->r", nu, np.linalg.solve(S, nu[..., None])[..., 0])
+        d2 = np.einsum("ri,ri->r", innovation, np.linalg.solve(S, innovation[..., None])[..., 0])
         if self.per == "reading":
             rejected = avail & (d2 > self.threshold(avail.sum(axis=1)))[:, None]
         else:
-            z2 = nu**2 / np.diagonal(S, axis1=-2, axis2=-1)
+            z2 = innovation**2 / np.diagonal(S, axis1=-2, axis2=-1)
             rejected = avail & (z2 > self.threshold(np.ones(m, dtype=int)))
         if self.recovery == "reacquire":
             rejected = rejected & ~recovering[:, None]
@@ -132,15 +134,59 @@ class ChiSquareGate:
         diag = {"gate_rejected": rejected, "gate_distance": d2,
                 "gate_recovery": recovering if self.recovery is not None else np.zeros(runs, dtype=bool),
                 "gate_count": new_count}
+        return rejected, diag, new_count
+
+    def screen(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
+               innovation: NDArray[np.float64], mask: NDArray[np.bool_] | None,
+               count: NDArray[np.int_] | None) -> tuple[NDArray[np.float64], NDArray[np.bool_] | None, dict, dict]:
+        """Test one reading of every run of a Kalman-type filter; return ``(P⁻, mask, diagnostics, extra)``.
+
+        ``P`` (runs, n, n) the prior (inflated on the recovering runs), ``mask`` the
+        channels to use ((runs, m); None: all), the diagnostics of the module
+        docstring and ``{"gate_count": …}`` to carry.
+        """
+        runs, m = innovation.shape
+        avail = np.ones((runs, m), dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
+        P = self.inflate(P, count)
+        Pg, Hg, Rg, nu = drop_missing(P, H, R, innovation, None if mask is None else avail)
+        S = Hg @ Pg @ np.swapaxes(Hg, -1, -2) + Rg
+        rejected, diag, new_count = self.decide(S, nu, avail, count)
         keep = avail & ~rejected
         new_mask = None if (mask is None and keep.all()) else keep
         return P, new_mask, diag, {"gate_count": new_count}
 
 
+class GateOption:
+    """Mixin: the ``gate`` option of a filter (a :class:`ChiSquareGate`, the dict of its parameters, or None)."""
+
+    _gate = None
+
+    @property
+    def gate(self) -> ChiSquareGate | None:
+        """The χ² innovation gate every reading passes before the correction (None: no gate).
+
+        A :class:`~hinfnav.estimators.gate.ChiSquareGate`: rejected channels are removed from the
+        update as missing ones are, its recovery policy keeps a run of rejections from locking the
+        filter out, and each step reports ``gate_rejected`` … (see :mod:`hinfnav.estimators.gate`).
+        A gated filter carries one covariance per run and runs on the NumPy path.
+        """
+        return self._gate
+
+    @gate.setter
+    def gate(self, value: ChiSquareGate | dict | None) -> None:
+        if isinstance(value, dict):  # the gate's parameters (a campaign cell's options are JSON)
+            value = ChiSquareGate(**value)
+        if value is not None and not isinstance(value, ChiSquareGate):
+            raise InputError(f"gate must be a hinfnav ChiSquareGate, the dict of its parameters or None; got "
+                             f"{type(value).__name__}")
+        self._gate = value
+
+
 def gated(estimator: Any, gate: ChiSquareGate | None = None, **options: Any) -> Any:
     """A copy of a Kalman-core ``estimator`` with ``gate`` (default ``ChiSquareGate(**options)``)."""
     if not hasattr(type(estimator), "gate"):
-        raise InputError(f"estimator {type(estimator).__name__} takes no gate (only filters of the Kalman core do)")
+        raise InputError(f"estimator {type(estimator).__name__} takes no gate (the Kalman core's filters and the "
+                         "sigma-point filter do)")
     new = copy.copy(estimator)
     new.gate = ChiSquareGate(**options) if gate is None else gate
     return new

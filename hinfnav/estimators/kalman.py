@@ -55,7 +55,7 @@ from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
-from .gate import ChiSquareGate
+from .gate import GateOption
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -71,7 +71,7 @@ OUTPUTS = ("filtered", "predicted")
 _TRANSIENT = ("prior", "PhiPPhiT", "Qd")
 
 
-class KalmanCore(KalmanCorrection, Estimator):
+class KalmanCore(GateOption, KalmanCorrection, Estimator):
     """The one Kalman core: hooks and the one update shared by every Kalman-type filter of the package.
 
     :class:`ExtendedKalmanFilter` (a linear system or a dynamics model) and
@@ -95,27 +95,6 @@ class KalmanCore(KalmanCorrection, Estimator):
     transient_keys = _TRANSIENT
     #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
     R_of_reading = None
-    _gate = None
-
-    @property
-    def gate(self) -> ChiSquareGate | None:
-        """The χ² innovation gate every reading passes before the correction (None: no gate).
-
-        A :class:`~hinfnav.estimators.gate.ChiSquareGate`: rejected channels are removed from the
-        update as missing ones are, its recovery policy keeps a run of rejections from locking the
-        filter out, and each step reports ``gate_rejected`` … (see :mod:`hinfnav.estimators.gate`).
-        A gated filter carries one covariance per run and runs on the NumPy path.
-        """
-        return self._gate
-
-    @gate.setter
-    def gate(self, value: ChiSquareGate | dict | None) -> None:
-        if isinstance(value, dict):  # the gate's parameters (a campaign cell's options are JSON)
-            value = ChiSquareGate(**value)
-        if value is not None and not isinstance(value, ChiSquareGate):
-            raise InputError(f"gate must be a hinfnav ChiSquareGate, the dict of its parameters or None; got "
-                             f"{type(value).__name__}")
-        self._gate = value
 
     @property
     def n_cov(self) -> int:
