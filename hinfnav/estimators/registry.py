@@ -228,7 +228,7 @@ def build_estimator(scenario: Any, name: str, **options: Any) -> Estimator:
 
     ``options`` go to its builder, except ``gate``: a
     :class:`~hinfnav.estimators.gate.ChiSquareGate` or the dict of its parameters (a campaign's cell
-    options), set on the filter built (a filter of the Kalman core).
+    options), set on the filter built (a filter of the Kalman core or the sigma-point filter).
     """
     entry = estimator_entry(name)
     why = fit_reason(scenario, name)
@@ -238,8 +238,9 @@ def build_estimator(scenario: Any, name: str, **options: Any) -> Estimator:
                          f"these do: {fitting}")
     gate = options.pop("gate", None)
     est = entry.builder(scenario, **options)
-    if gate is not None:  # a χ² innovation gate on a filter of the Kalman core (hinfnav.estimators.gate)
+    if gate is not None:  # a χ² innovation gate (hinfnav.estimators.gate)
         if not hasattr(type(est), "gate"):
-            raise InputError(f"gate: filter {name!r} is not of the Kalman core and takes no gate")
+            raise InputError(f"gate: filter {name!r} takes no gate (the Kalman core's filters and the sigma-point "
+                             "filter do)")
         est.gate = gate  # a dict is the gate's parameters (the filter's setter builds it)
     return est
