@@ -50,7 +50,7 @@ from ..io.outputs import MARKER, check_output_dir, output_lock, to_json
 from ..io.progress import bar_disabled
 from ..io.provenance import package_version
 from ..estimators.registry import build_estimator, estimator_entry
-from ..metrics.accumulator import StatisticsSink
+from ..metrics.accumulator import GATE_KEY, StatisticsSink
 from ..metrics.consistency import NIS_KEYS, warn_if_diverged
 from ..sim.engine import run_monte_carlo, truth_batch
 from .registry import build_scenario, scenario_entry
@@ -156,7 +156,7 @@ def run_unit(unit: Mapping[str, Any]) -> list[dict[str, Any]]:
         sink.timed(c["cell_id"], time.perf_counter() - t0, time.process_time() - c0)
     if estimators:  # the engine's open loop; each cell's failures and time kept apart by the sink
         run_monte_carlo(scenario, estimators, sink=sink, runs=runs, seed=unit["seed"], batch_size=bs,
-                        noise=unit["noise"], keep_covariance=True, diagnostics=NIS_KEYS, max_bytes=CONSISTENCY_BYTES,
+                        noise=unit["noise"], keep_covariance=True, diagnostics=NIS_KEYS + (GATE_KEY,), max_bytes=CONSISTENCY_BYTES,
                         **unit["conditions"])
     errors, elapsed, cpu, accs = sink.errors, sink.elapsed, sink.cpu, sink.accumulators
     truth_s, truth_cpu = sink.truth_s, sink.truth_cpu

@@ -13,7 +13,9 @@ samples) with ``rms_ci95_low`` / ``rms_ci95_high`` (its 95 % interval,
 ``spread95_high`` (2.5 and 97.5 % of the runs' RMS: what one run may give),
 ``max_abs``. Per cell (window ``""``, quantity ``"all"``):
 ``convergence_median_s`` and ``convergence_fraction`` when the campaign has
-tolerances, ``nonfinite_runs``, ``diverged`` (1 or 0) and ``diverged_runs``.
+tolerances, ``nonfinite_runs``, ``diverged`` (1 or 0) and ``diverged_runs``; for a gated filter
+(:mod:`hinfnav.estimators.gate`) ``gate_rejected_readings``, ``gate_rejected_channels`` and
+``gate_rejected_fraction`` (its rejections over every run and step of the cell).
 Consistency per window (quantity ``nees`` or ``nis``, kind
 ``consistency``): ``mean`` (window mean of the run-averaged statistic),
 ``inside_fraction`` (steps inside the 95 % χ² bounds), ``bound_low``,
@@ -62,6 +64,10 @@ def _rows(cell):
         yield dict(rb, unit="s", statistic="convergence_median_s", value=_num(conv["median_s"]))
         yield dict(rb, unit="", statistic="convergence_fraction", value=_num(conv["fraction"]))
     yield dict(rb, unit="", statistic="nonfinite_runs", value=float(st["nonfinite_runs"]))
+    gate = st.get("gate")
+    if gate is not None:  # a gated filter's rejections (hinfnav.estimators.gate)
+        for stat in ("rejected_readings", "rejected_channels", "rejected_fraction"):
+            yield dict(rb, unit="", statistic=f"gate_{stat}", value=float(gate[stat]))
     cons = st.get("consistency")
     if cons is None:  # a cell written before the consistency statistics
         return

@@ -20,6 +20,9 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .recursive_hinf import RecursiveHInfinityFilter
     from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
     from .lti import LTIFilter
+    from .variational import NoiseAdaptiveFilter, StudentTFilter
+    from .correntropy import CorrentropyFilter
+    from .gate import ChiSquareGate, gate_report, gated
     from .sigma_point import SigmaPointFilter
     from .smoothers import SmoothedHistory, filter_smoother_consistency, smooth
     from .sqrt import SquareRootEKF, SquareRootSigmaPointFilter, square_root
@@ -61,6 +64,12 @@ __all__ = [
     "AugmentedInputKF",
     "AugmentedInputSTKF",
     "AugmentedInputAdaptiveKF",
+    "StudentTFilter",
+    "NoiseAdaptiveFilter",
+    "CorrentropyFilter",
+    "ChiSquareGate",
+    "gate_report",
+    "gated",
     "register_estimator",
     "build_estimator",
     "registered_estimators",

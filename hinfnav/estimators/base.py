@@ -459,6 +459,11 @@ class Estimator:
         keys = history_keys(keep_covariance, diagnostics)
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
+        if getattr(self, "gate", None) is not None and backend != "numpy":  # a gate runs on the NumPy path only
+            if backend == "numba":
+                raise InputError(f"backend='numba' is not available for filter {self.name!r}: its gate runs on the "
+                                 "NumPy path only; use backend='numpy' or 'auto'")
+            backend = "numpy"
         if xhat0.ndim == 2:  # one prior per run: the NumPy step loop
             if backend == "numba":
                 raise InputError("backend='numba' takes one xhat0 (n,) for every run; use backend='numpy' (or "

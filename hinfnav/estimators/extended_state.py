@@ -183,8 +183,9 @@ class ExtendedStateKalmanFilter(ExtendedKalmanFilter):
         return x_post, P_post, {"theta": np.full(x.shape[0], self.theta)}
 
     def _update(self, state, y):
-        """As :meth:`ExtendedKalmanFilter._update`, without re-evaluating the (linear) measurement's Jacobian."""
-        if not self.measurement.linear:
+        """As :meth:`ExtendedKalmanFilter._update`, without re-evaluating the (linear) measurement's Jacobian
+        (a gated filter takes the core's update, where the gate screens the reading)."""
+        if not self.measurement.linear or self.gate is not None:
             return super()._update(state, y)
         x, P = state.x, state.P
         H = self.measurement.H

@@ -24,6 +24,11 @@ variants override small hooks:
   steady-gain freeze's record, :mod:`hinfnav.estimators.steady`);
 * :meth:`~ExtendedKalmanFilter.correct` — the Joseph-form Kalman update
   (the Huber filter replaces it by an M-estimation);
+* :meth:`~KalmanCore.carried` — items of a correction's diagnostics kept for
+  the next reading (the noise-adaptive filter's α, β,
+  :mod:`hinfnav.estimators.variational`); :attr:`~KalmanCore.gate` — a χ²
+  innovation gate screening each reading before the correction
+  (:mod:`hinfnav.estimators.gate`);
 * :meth:`~ExtendedKalmanFilter.measurement_covariance` — ``R_k``, constant
   unless the measurement's covariance depends on its reading (a converted
   range/angle measurement: ``J R Jᵀ`` at each reading);
@@ -50,6 +55,7 @@ from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
+from .gate import GateOption
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -65,7 +71,7 @@ OUTPUTS = ("filtered", "predicted")
 _TRANSIENT = ("prior", "PhiPPhiT", "Qd")
 
 
-class KalmanCore(KalmanCorrection, Estimator):
+class KalmanCore(GateOption, KalmanCorrection, Estimator):
     """The one Kalman core: hooks and the one update shared by every Kalman-type filter of the package.
 
     :class:`ExtendedKalmanFilter` (a linear system or a dynamics model) and
@@ -153,6 +159,11 @@ class KalmanCore(KalmanCorrection, Estimator):
         """Extra items to keep after a prediction to P(k+1|k) (none here; a gain freeze keeps its record)."""
         return {}
 
+    def carried(self, diagnostics: dict[str, Any]) -> dict[str, Any]:
+        """Items of the correction's diagnostics to keep in ``FilterState.extra`` for the next reading (none here;
+        the noise-adaptive filter keeps its α, β)."""
+        return {}
+
     def measurement_covariance(self, y: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """``R_k`` at this step: the measurement's ``noise_covariance(y_k)`` (runs, m, m) if it has one, else None.
 
@@ -180,7 +191,7 @@ class KalmanCore(KalmanCorrection, Estimator):
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
         x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
         x = np.broadcast_to(x0, (runs, x0.size)).copy()
-        if not self.shares_covariance:
+        if not self.shares_covariance or self._gate is not None:  # a gate's rejections depend on the data
             P = np.broadcast_to(P, (runs,) + P.shape).copy()
         return FilterState(x=x, P=P)
 
@@ -206,6 +217,12 @@ class KalmanCore(KalmanCorrection, Estimator):
                                                     mask=mask)
             diag_prior.update(d_hook)
             extra.update(e_hook)
+        shown = mask  # the channels the reading has (a rejected channel's innovation is still reported)
+        if self._gate is not None:
+            P, mask, d_gate, e_gate = self._gate.screen(P, H, self.R if R_k is None else R_k, innovation, mask,
+                                                        state.extra.get("gate_count"))
+            diag_prior.update(d_gate)
+            extra.update(e_gate)
         try:
             if mask is None:
                 x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
@@ -222,7 +239,8 @@ class KalmanCore(KalmanCorrection, Estimator):
         if self.refuse_nonfinite and not (np.all(np.isfinite(x_post)) and np.all(np.isfinite(P_post))):
             raise HinfnavError(f"filter {self.name!r} diverged at step {state.k}: its covariance or correction is not finite")
         extra.update(self.after_update(state, x_post))
-        diag = dict(diag_prior, **diag, innovation=innovation if mask is None else np.where(mask, innovation, np.nan))
+        extra.update(self.carried(diag))
+        diag = dict(diag_prior, **diag, innovation=innovation if shown is None else np.where(shown, innovation, np.nan))
         diag.update(self.update_diagnostics(x_post))
         new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(extra, prior=(x, P)))
         if self.output == "filtered":

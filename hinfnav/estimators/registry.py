@@ -230,7 +230,9 @@ def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph"
 
     ``covariance_form="sqrt"`` gives its square-root (Cholesky-factor) form
     (:func:`~hinfnav.estimators.sqrt.square_root`; an InputError for a filter without one). ``options`` go to
-    the builder (e.g. ``form="observer"`` of a designed filter).
+    the builder (e.g. ``form="observer"`` of a designed filter), except ``gate``: a
+    :class:`~hinfnav.estimators.gate.ChiSquareGate` or the dict of its parameters (a campaign's cell
+    options), set on the filter built (a filter of the Kalman core or the sigma-point filter).
     """
     form = as_choice("covariance_form", covariance_form, FORMS)
     entry = estimator_entry(name)
@@ -239,5 +241,11 @@ def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph"
         fitting = ", ".join(registered_estimators(scenario))
         raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "
                          f"these do: {fitting}")
+    gate = options.pop("gate", None)
     est = entry.builder(scenario, **options)
+    if gate is not None:  # a χ² innovation gate (hinfnav.estimators.gate)
+        if not hasattr(type(est), "gate"):
+            raise InputError(f"gate: filter {name!r} takes no gate (the Kalman core's filters and the sigma-point "
+                             "filter do)")
+        est.gate = gate  # a dict is the gate's parameters (the filter's setter builds it)
     return est if form == "joseph" else square_root(est)

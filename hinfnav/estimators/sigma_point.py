@@ -62,6 +62,7 @@ from ..core.validation import as_choice, as_nonnegative, as_positive, as_real, a
 from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
 from ..systems.state import StateSpec
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
+from .gate import GateOption
 from .kalman import OUTPUTS, ExtendedKalmanFilter
 
 if TYPE_CHECKING:
@@ -99,7 +100,7 @@ def sigma_points(x, P, scale, center=True):
     return np.concatenate(parts, axis=1)
 
 
-class SigmaPointFilter(Estimator):
+class SigmaPointFilter(GateOption, Estimator):
     """Unscented (or cubature) Kalman filter of any dynamics and measurement model (see the module docstring).
 
     Parameters
@@ -208,6 +209,17 @@ class SigmaPointFilter(Estimator):
             return np.asarray(self.system.predict_mean(X, u))
         return np.asarray(self.system.f(X, u, t))
 
+    @staticmethod
+    def _without(mask, dY, R_k, innovation):
+        """``(dY, R, ν)`` with the channels ``~mask`` removed exactly, as drop_missing does for the Kalman
+        correction: their output deviations and innovation zeroed, their rows and columns of R decoupled (S block
+        diagonal, K's column 0), so the rest of the update is the filter's without them (mask None: all kept)."""
+        if mask is None:
+            return dY, R_k, innovation
+        both = mask[:, :, None] & mask[:, None, :]
+        return (np.where(mask[:, None, :], dY, 0.0), np.where(both, R_k, 0.0) + np.eye(R_k.shape[-1]) * ~mask[:, None, :],
+                np.where(mask, innovation, 0.0))
+
     def _cov(self, A, B):
         """``Σ W_i^c A_i B_iᵀ`` for deviations A (runs, N, a), B (runs, N, b)."""
         return np.swapaxes(A * self.Wc[:, None], -1, -2) @ B
@@ -225,6 +237,9 @@ class SigmaPointFilter(Estimator):
         x, P = state.x, state.P
         runs, n = x.shape
         mask = available_channels(y) if self.missing == "skip" else None
+        gate, count = self._gate, state.extra.get("gate_count")
+        if gate is not None:  # a run recovering from rejections: its prior inflated before the points are drawn
+            P = gate.inflate(P, count)
         dX = self._points(P, state.k, "prior")
         X = self._inject(x[:, None, :], dX)
         N = X.shape[1]
@@ -242,26 +257,32 @@ class SigmaPointFilter(Estimator):
         y, mask = fill_missing(self.measurement, y, x, y_mean, mask)  # a missing channel reads as predicted
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
         innovation = self.measurement.residual(y, y_mean)
-        if mask is not None:
-            # the channel removed exactly, as drop_missing does for the Kalman correction: its output
-            # deviations and innovation zeroed, its rows and columns of R decoupled (S block diagonal, K's
-            # column 0), so the rest of the update is the filter's without that channel
-            if self.R_of_reading is not None:  # R(y) not finite on the channels it has: the reading is not used
-                both = mask[:, :, None] & mask[:, None, :]
-                mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
-            dY = np.where(mask[:, None, :], dY, 0.0)
+        if mask is not None and self.R_of_reading is not None:
+            # R(y) not finite on the channels it has: the reading is not used
             both = mask[:, :, None] & mask[:, None, :]
-            R_k = np.where(both, R_k, 0.0) + np.eye(R_k.shape[-1]) * ~mask[:, None, :]
-            innovation = np.where(mask, innovation, 0.0)
-        S = self._cov(dY, dY) + R_k
+            mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
+        shown, raw = mask, innovation  # the channels the reading has (a rejected channel's innovation is reported)
+        dY_u, R_u, nu_u = self._without(mask, dY, R_k, innovation)
+        S = self._cov(dY_u, dY_u) + R_u
+        d_gate = {}
+        if gate is not None:
+            avail = np.ones(innovation.shape, dtype=bool) if mask is None else mask
+            rejected, d_gate, new_count = gate.decide(S, nu_u, avail, count)
+            if rejected.any():
+                mask = avail & ~rejected
+                dY_u, R_u, nu_u = self._without(mask, dY, R_k, innovation)
+                S = self._cov(dY_u, dY_u) + R_u
+        dY, innovation = dY_u, nu_u
         Pxy = self._cov(dX, dY)
         K = Pxy @ inv_spd(S)
         x_post = self._inject(x, (K @ innovation[:, :, None])[:, :, 0])
         P_post = P - K @ S @ np.swapaxes(K, -1, -2)
         P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
-        diag = {"innovation": innovation if mask is None else np.where(mask, innovation, np.nan),
-                "innovation_covariance": S}
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=dict(state.extra))
+        diag = dict(d_gate, innovation=raw if shown is None else np.where(shown, raw, np.nan), innovation_covariance=S)
+        extra = dict(state.extra)
+        if gate is not None:
+            extra["gate_count"] = new_count
+        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
         if self.output == "filtered":
             return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
         return new, StepOutput(xhat=x, P=P, diagnostics=diag)

@@ -41,7 +41,11 @@ if TYPE_CHECKING:
     from ..sim.truth import Truth
     from ..systems.state import StateSpec
 
-__all__ = ["WindowStatistics", "StatisticsAccumulator", "StatisticsSink", "group_summary", "rms_interval", "add_batch"]
+__all__ = ["WindowStatistics", "StatisticsAccumulator", "StatisticsSink", "group_summary", "rms_interval", "add_batch",
+           "GATE_KEY"]
+
+#: The diagnostic of a gated filter (:mod:`hinfnav.estimators.gate`) whose rejections a cell counts.
+GATE_KEY = "gate_rejected"
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,6 +104,8 @@ def add_batch(acc: StatisticsAccumulator, start: int, truth: Truth, history: Est
                                None if P is None else P[:, 0], err[:, 0])
         acc.add(start, truth.t, err, truth.state, P, history.diagnostics.get(NIS_KEYS[0]),
                 history.diagnostics.get(NIS_KEYS[1]), scale0)
+    if GATE_KEY in history.diagnostics:
+        acc.add_rejections(history.diagnostics[GATE_KEY])
 
 
 class StatisticsSink(Sink):
@@ -156,6 +162,27 @@ class StatisticsAccumulator:
         self._masks = None
         self._conv = []
         self.consistency = ConsistencyAccumulator(self.runs)
+        self._gate = None
+
+    def add_rejections(self, rejected: ArrayLike) -> None:
+        """Count a gated filter's rejections: ``rejected`` (batch, samples, m) bool, the ``gate_rejected`` history."""
+        rejected = np.asarray(rejected, dtype=bool)
+        if self._gate is None:
+            self._gate = {"readings": 0, "rejected_readings": 0, "per_channel": np.zeros(rejected.shape[2], dtype=int)}
+        self._gate["readings"] += rejected.shape[0] * rejected.shape[1]
+        self._gate["rejected_readings"] += int(rejected.any(axis=2).sum())
+        self._gate["per_channel"] += rejected.sum(axis=(0, 1))
+
+    @property
+    def gate(self) -> dict[str, Any] | None:
+        """A gated filter's rejections (None for a filter without a gate): ``readings`` seen, ``rejected_readings``
+        (with at least one channel rejected), ``rejected_channels`` and ``per_channel``, ``rejected_fraction``."""
+        if self._gate is None:
+            return None
+        g = self._gate
+        return {"readings": g["readings"], "rejected_readings": g["rejected_readings"],
+                "rejected_channels": int(g["per_channel"].sum()), "per_channel": [int(v) for v in g["per_channel"]],
+                "rejected_fraction": g["rejected_readings"] / max(g["readings"], 1)}
 
     def add(self, start: int, t: NDArray[np.float64], err: NDArray[np.float64], state: StateSpec | None, P: NDArray[np.float64] | None = None,
             innovation: NDArray[np.float64] | None = None, S: NDArray[np.float64] | None = None, scale0: NDArray[np.float64] | None = None) -> None:
@@ -235,10 +262,13 @@ class StatisticsAccumulator:
             done = np.isfinite(c)
             conv = {"tol": list(self._tol), "fraction": float(done.mean()),
                     "median_s": float(np.median(c[done])) if done.any() else None}
-        return {"labels": labels, "units": units,
-                "groups": {g: {"indices": list(idx), "unit": units[idx[0]]} for g, idx in groups.items()},
-                "windows": windows, "convergence": conv, "nonfinite_runs": self.nonfinite,
-                "consistency": self.consistency.result(filter_name).summary(self.windows)}
+        out = {"labels": labels, "units": units,
+               "groups": {g: {"indices": list(idx), "unit": units[idx[0]]} for g, idx in groups.items()},
+               "windows": windows, "convergence": conv, "nonfinite_runs": self.nonfinite,
+               "consistency": self.consistency.result(filter_name).summary(self.windows)}
+        if self._gate is not None:  # a gated filter: its rejections (the key is absent otherwise)
+            out["gate"] = self.gate
+        return out
 
 
 def rms_interval(ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -24,7 +24,7 @@ NOTEBOOK_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 
 #: Notebooks of no single paper (a reader's own system); the primary paper (sun2011, whose output is the
 #: folder's root) executes them after its own.
-CROSS_PAPER = ("80_your_own_system.ipynb", "82_marginal_plants_flexible_mode.ipynb")
+CROSS_PAPER = ("80_your_own_system.ipynb", "81_robust_filters_huang2017.ipynb", "82_marginal_plants_flexible_mode.ipynb")
 
 
 def execute_notebook(path, target, *, timeout=900):

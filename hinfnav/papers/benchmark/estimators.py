@@ -1,4 +1,4 @@
-"""The benchmark's generic estimators: five filters built from any scenario's declared Kalman model.
+"""The benchmark's generic estimators: eight filters built from any scenario's declared Kalman model.
 
 A scenario that offers the ``"kalman"`` model (:class:`~hinfnav.estimators.registry.Offers`) has
 ``kalman_model()``: its system (a LinearSystem or a dynamics model), its measurement model, the filters'
@@ -10,6 +10,12 @@ on its rate, input unit/s, and ``input_std0``, its initial σ). On it:
 ``model_ukf``       its sigma-point version (:meth:`~hinfnav.estimators.SigmaPointFilter.from_ekf`)
 ``model_hbf``       its Huber version (:meth:`~hinfnav.estimators.HuberFilter.from_ekf`, γ = 1.345)
 ``model_stekf``     strong tracking (:class:`~hinfnav.estimators.kalman.StrongTrackingEKF`, ρ = 0.95, β = 1)
+``model_stkf``      Huang et al. (2017)'s Student-t filter (:class:`~hinfnav.estimators.variational.StudentTFilter`;
+                    ω = ν = 5, N = 10, τ = 1e-8, the paper's choices)
+``model_vbakf``     Särkkä & Nummenmaa (2009)'s noise-adaptive VB filter
+                    (:class:`~hinfnav.estimators.variational.NoiseAdaptiveFilter`; ρ = 1, N = 5, R the prior)
+``model_mckf``      Chen et al. (2017)'s maximum-correntropy filter
+                    (:class:`~hinfnav.estimators.correntropy.CorrentropyFilter`; σ = 2, ε = 1e-6)
 ``model_adaptive``  the unknown input as a random walk whose noise follows its estimated rate
                     (:class:`~hinfnav.estimators.augmented.AugmentedInputAdaptiveKF`; linear dynamics):
                     Q = ḟ_max² T, base Q/100, ε with Q/100 (ε ḟ_max)² = Q, memory m = 50 steps —
@@ -30,10 +36,12 @@ from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...estimators.attitude import AttitudeHuberEKF
 from ...estimators.augmented import AugmentedInputAdaptiveKF
+from ...estimators.correntropy import CorrentropyFilter
 from ...estimators.huber_filter import HuberFilter
 from ...estimators.kalman import ExtendedKalmanFilter, StrongTrackingEKF
 from ...estimators.registry import Requires, register_estimator
 from ...estimators.sigma_point import SigmaPointFilter
+from ...estimators.variational import NoiseAdaptiveFilter, StudentTFilter
 from ...systems.attitude import AttitudeSystem
 from ..attitude2018.constants import PAPER_Q_BEST_AEKF
 from ..attitude2018.filters import torque_density
@@ -50,7 +58,16 @@ GENERIC = {
     "model_hbf": ("hbf", "Huber-based filter of the scenario's declared Kalman model"),
     "model_stekf": ("stekf", "strong-tracking EKF of the scenario's declared Kalman model"),
     "model_adaptive": ("adaptive", "Kalman filter with the unknown input as a rate-adapted random walk"),
+    "model_stkf": ("stkf", "Student-t variational filter (Huang et al. 2017) of the scenario's declared Kalman model"),
+    "model_vbakf": ("vbakf", "variational-Bayes noise-adaptive filter (Sarkka & Nummenmaa 2009) of the scenario's "
+                             "declared Kalman model"),
+    "model_mckf": ("mckf", "maximum-correntropy Kalman filter (Chen et al. 2017) of the scenario's declared Kalman "
+                           "model"),
 }
+
+#: The robust variants of the Kalman model's EKF built through their ``from_ekf``.
+_FROM_EKF = {"ukf": SigmaPointFilter, "hbf": HuberFilter, "stkf": StudentTFilter, "vbakf": NoiseAdaptiveFilter,
+             "mckf": CorrentropyFilter}
 
 
 def _model(scenario):
@@ -64,7 +81,7 @@ def _model(scenario):
 
 @scenario_moved("kind", "scenario", was=str)
 def build_generic(scenario, kind, **options):
-    """One of the five filters of the module table on ``scenario``'s Kalman model (``options`` to its class)."""
+    """One of the eight filters of the module table on ``scenario``'s Kalman model (``options`` to its class)."""
     m = _model(scenario)
     system, meas, P0 = m["system"], m["measurement"], m["P0"]
     name = f"model_{kind}"
@@ -83,9 +100,7 @@ def build_generic(scenario, kind, **options):
                                **(options if kind == "ekf" else {}))
     if kind == "ekf":
         return ekf
-    if kind == "ukf":
-        return SigmaPointFilter.from_ekf(ekf, name=name, **options)
-    return HuberFilter.from_ekf(ekf, name=name, **options)
+    return _FROM_EKF[kind].from_ekf(ekf, name=name, **options)
 
 
 def _builder(kind):
