@@ -9,6 +9,9 @@ all --notebooks`` executes every notebook once.
 """
 
 import ast
+import os
+import time
+from datetime import datetime
 from pathlib import Path
 
 from tqdm import tqdm
@@ -27,6 +30,8 @@ NOTEBOOK_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 CROSS_PAPER = ("80_your_own_system.ipynb",)
 
 
+#: The kernel manager of every execution (a dotted name: nbclient imports it, with jupyter_client, only then).
+KERNEL_MANAGER = "hinfnav.papers.notebook_kernel.KernelManager"
 #: Seconds a cell may run (the documentation build and the test suite use the same).
 CELL_TIMEOUT_S = 900
 #: Seconds the kernel may take to report idle after a cell's reply; past it the run fails.
@@ -42,8 +47,6 @@ class NotebookStallError(HinfnavError):
 
 def _cells_seconds(nb):
     """Sum over code cells of the kernel's busy → idle time (nbclient's ``execution`` timing metadata)."""
-    from datetime import datetime
-
     total = 0.0
     for cell in nb.cells:
         timing = cell.get("metadata", {}).get("execution", {})
@@ -89,18 +92,13 @@ def execute_notebook(path, target=None, *, timeout=CELL_TIMEOUT_S, cwd=None, ext
     NotebookStallError
         See above. A failing cell raises nbclient's ``CellExecutionError``; either writes nothing.
     """
-    import os
-    import time
-
     import nbformat  # heavy optional libraries: only when notebooks are asked for
     from nbclient import NotebookClient
-
-    from .notebook_kernel import KernelManager
 
     path = Path(path)
     nb = nbformat.read(path, as_version=4)
     start = time.perf_counter()
-    client = NotebookClient(nb, timeout=timeout, kernel_name="python3", kernel_manager_class=KernelManager,
+    client = NotebookClient(nb, timeout=timeout, kernel_name="python3", kernel_manager_class=KERNEL_MANAGER,
                             iopub_timeout=iopub_timeout, raise_on_iopub_timeout=True, record_timing=True,
                             resources={"metadata": {"path": str(cwd or NOTEBOOK_DIR)}},
                             extra_arguments=list(extra_arguments))
