@@ -17,6 +17,7 @@ from .hill import (
 from .dynamics import ConstantTurn, ContinuousDynamics, DiscreteDynamics, DynamicsModel, constant_turn_state_spec
 from .linear import LinearSystem
 from .measurements import (
+    ConvertedPosition,
     LinearMeasurement,
     MeasurementModel,
     RangeAzimuthElevation,
@@ -34,6 +35,7 @@ from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 
 __all__ = [
+    "ConvertedPosition",
     "StateSpec",
     "chaser_state_spec",
     "LinearSystem",
