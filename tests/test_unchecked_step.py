@@ -51,3 +51,4 @@ def test_no_module_outside_the_estimators_calls_a_filters_private_step():
                     and not (isinstance(node.func.value, ast.Call) and getattr(node.func.value.func, "id", "") == "super")):
                 offenders.append(f"{path.relative_to(ROOT)}:{node.lineno} .{node.func.attr}")
     assert not offenders, offenders
+
