@@ -46,26 +46,20 @@ def execute_notebook(notebook, executed_dir=EXECUTED):
     """Execute one notebook in its own folder and write the executed copy atomically into ``executed_dir``.
 
     The test suite's notebook items (``notebooks/conftest.py``) call this too, so a CI run executes each
-    notebook once: the docs then reuse the copies the tests wrote. Returns ``(name, seconds)``; a failing
-    cell raises nbclient's ``CellExecutionError`` and writes no copy.
+    notebook once: the docs then reuse the copies the tests wrote. The execution is the package's
+    (:func:`hinfnav.papers.notebooks.execute_notebook`: a client that reads each reply when it arrives,
+    and fails loudly on a kernel that does not go idle or a run much longer than its cells). Returns
+    ``(name, seconds)``; a failing cell raises nbclient's ``CellExecutionError`` and writes no copy.
     """
-    import nbformat
-    from nbclient import NotebookClient
+    from hinfnav.papers.notebooks import execute_notebook as run
 
-    start = time.perf_counter()
-    nb = nbformat.read(notebook, as_version=4)
+    notebook = Path(notebook)
     # --matplotlib=inline and the inline backend in the kernel's environment: a Figure left as a cell's
     # value is drawn as a PNG even where the notebook never imports pyplot (the package builds its figures
     # without pyplot's global state), whatever MPLBACKEND the caller has (CI sets Agg).
-    client = NotebookClient(nb, timeout=TIMEOUT_S, resources={"metadata": {"path": str(notebook.parent)}},
-                            extra_arguments=["--matplotlib=inline"])
-    client.execute(env=dict(os.environ, MPLBACKEND=INLINE_BACKEND))
-    executed_dir = Path(executed_dir)
-    executed_dir.mkdir(parents=True, exist_ok=True)
-    tmp = executed_dir / f".{notebook.name}.{os.getpid()}.tmp"
-    nbformat.write(nb, tmp)
-    os.replace(tmp, executed_dir / notebook.name)
-    return notebook.name, time.perf_counter() - start
+    _, seconds = run(notebook, Path(executed_dir) / notebook.name, timeout=TIMEOUT_S, cwd=notebook.parent,
+                     extra_arguments=["--matplotlib=inline"], env=dict(os.environ, MPLBACKEND=INLINE_BACKEND))
+    return notebook.name, seconds
 
 
 _execute = execute_notebook

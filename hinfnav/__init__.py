@@ -98,7 +98,7 @@ _lazy_getattr, __dir__ = lazy_exports(__name__)
 
 
 def __getattr__(name: str) -> object:
-    if name == "__version__":  # from git in a checkout (see io.provenance.package_version); computed once
+    if name == "__version__":  # the installed distribution's (see io.provenance.package_version); computed once
         globals()[name] = value = importlib.import_module(".io.provenance", __name__).package_version()
         return value
     home = _MOVED.get(name)

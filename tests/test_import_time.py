@@ -113,3 +113,30 @@ def test_every_lazy_export_resolves_to_the_object_not_a_module(path):
     assert set(exports) <= set(dir(module))
     with pytest.raises(AttributeError, match=f"{module_name}.*no_such_name"):
         module.no_such_name  # noqa: B018
+
+
+def test_importing_one_paper_loads_no_other_paper_and_no_solver_or_plotting():
+    # issue 37 item 6: `import hinfnav.papers.yang2020` loaded 2,043 modules (every paper, cvxpy, control,
+    # matplotlib, pandas); a paper now loads on first use, and its figures and solvers when asked for.
+    loaded = probe("hinfnav.papers.yang2020")["modules"]
+    assert not _heavy(loaded), f"import hinfnav.papers.yang2020 loads {_heavy(loaded)}"
+    papers = sorted({m.split(".")[2] for m in loaded if m.startswith("hinfnav.papers.")})
+    assert papers == ["yang2020"], f"import hinfnav.papers.yang2020 loads the papers {papers}"
+
+
+def test_the_registry_still_sees_every_paper():
+    # the providers entry point calls hinfnav.papers.register(): a fresh process lists every paper's names
+    code = ("import json; from hinfnav.estimators import registered_estimators; "
+            "from hinfnav.campaign import registered_scenarios; "
+            "print(json.dumps([registered_estimators(), registered_scenarios()]))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+           "MPLBACKEND": "Agg"}
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    estimators, scenarios = json.loads(proc.stdout.strip().splitlines()[-1])
+    import hinfnav.papers  # noqa: F401  (in this process too)
+    from hinfnav.estimators import registered_estimators
+
+    assert set(estimators) == set(registered_estimators()) and len(estimators) >= 30
+    assert {"ekf", "yang2020_alg2", "hbf", "aekf"} <= set(estimators)
+    assert scenarios == ["attitude2018", "sun2011", "shi2018", "yang2020"]  # as main 0d4cc82 registered them

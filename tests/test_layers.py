@@ -26,7 +26,6 @@ PACKAGE = ROOT / "hinfnav"
 #: anywhere else would dodge an import cycle: refused.
 LOCAL_IMPORT_ALLOWED = {"hinfnav/cli.py": "deferred imports: each command loads only the layers it needs"}
 HEAVY_OPTIONAL = ("nbformat", "nbclient", "matplotlib", "papermill", "distributed", "dask",
-                  "setuptools_scm",  # the version from git, only in a source checkout
                   "numba")  # the compiled backend, imported only when backend="numba"/"auto" asks for a kernel
 
 

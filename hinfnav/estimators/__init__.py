@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .saturated_state import FusedExtendedStateFilter, SaturatedExtendedStateFilter
     from .correction import KalmanCorrection, drop_missing, joseph_covariance, joseph_update, kalman_gain
     from .huber_filter import HuberCorrection, HuberFilter, HuberStrongTrackingEKF
-    from .recursive_hinf import RecursiveHInfinityFilter
+    from .recursive_hinf import ExtendedHInfinityFilter, RecursiveHInfinityFilter
     from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore, RateAdaptiveEKF, StrongTrackingEKF
     from .lti import LTIFilter
     from .variational import NoiseAdaptiveFilter, StudentTFilter
@@ -54,6 +54,7 @@ __all__ = [
     "SaturatedExtendedStateFilter",
     "FusedExtendedStateFilter",
     "RecursiveHInfinityFilter",
+    "ExtendedHInfinityFilter",
     "SigmaPointFilter",
     "StrongTracking",
     "StrongTrackingEKF",

@@ -401,6 +401,23 @@ class Estimator:
         self._check_order(state, "feed_input", "prior")
         return self._check_step_input(state, u, "feed_input")
 
+    # -- unchecked steps: for inner loops that check their arrays once (as ``estimate`` does) ---------
+
+    def update_unchecked(self, state: FilterState, y: NDArray[np.float64]) -> tuple[FilterState, StepOutput]:
+        """:meth:`update` without its checks, for an inner loop that checked its readings once.
+
+        ``y`` must be a finite float (runs, n_meas) array (NaN channels only with ``missing="skip"``);
+        nothing is checked and the call order is not tracked (the returned state's ``phase`` is not
+        maintained: keep calling the unchecked methods on it). The numbers are bitwise those of
+        :meth:`update`.
+        """
+        return self._update(state, y)
+
+    def predict_unchecked(self, state: FilterState, u: NDArray[np.float64] | None) -> FilterState:
+        """:meth:`predict` without its checks: ``u`` a finite float (runs, n_input) array, or None when the
+        filter does not use its input (see :meth:`update_unchecked`)."""
+        return self._predict(state, u)
+
     @staticmethod
     def _phase(new, old, phase):
         """``new`` marked with ``phase`` (a copy when a hook handed back the state it was given)."""

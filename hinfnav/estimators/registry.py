@@ -141,12 +141,18 @@ def providers() -> tuple[str, ...]:
 
 
 def load_providers() -> dict[str, str]:
-    """Import the providers (registering their scenarios and estimators); return those that failed, with why."""
+    """Import the providers (registering their scenarios and estimators); return those that failed, with why.
+
+    A provider module that defines ``register()`` (``hinfnav.papers`` does: its papers load lazily) has it
+    called after the import; the others register as they are imported.
+    """
     _PROVIDERS["loaded"] = True  # first, so that a provider asking for the registry while it loads does not recurse
     failed = {}
     for ep in metadata.entry_points(group=PROVIDER_GROUP):
         try:
-            ep.load()
+            provider = ep.load()
+            if callable(getattr(provider, "register", None)):
+                provider.register()
         except ImportError as exc:  # pragma: no cover - a provider under construction
             failed[ep.value] = str(exc)
     return failed

@@ -373,8 +373,13 @@ class FusedExtendedStateFilter(Estimator):
         """The state with the input u_k (runs, n_input) whose drag-free part the next accelerometer reading contains."""
         return self._feed_input(state, self._check_feed_input(state, u))
 
+    def feed_input_unchecked(self, state: FilterState, u: NDArray[np.float64]) -> FilterState:
+        """:meth:`feed_input` without its checks: ``u`` a finite float (runs, n_input) array (see
+        :meth:`~hinfnav.estimators.base.Estimator.update_unchecked`)."""
+        return self._feed_input(state, u)
+
     def _feed_input(self, state: FilterState, u: NDArray[np.float64]) -> FilterState:
-        """:meth:`feed_input`'s hook, ``u`` already checked (a loop that checked its inputs once calls it)."""
+        """:meth:`feed_input`'s hook, ``u`` already checked."""
         return FilterState(x=state.x, P=state.P, k=state.k, extra=dict(state.extra, u_feed=u[:, self.uidx]),
                            phase=state.phase)
 

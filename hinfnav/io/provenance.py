@@ -24,20 +24,14 @@ def _source_root() -> Path:
 
 
 def package_version() -> str:
-    """hinfnav's version: from git in a source checkout, else the installed distribution's.
+    """hinfnav's version: the installed distribution's (``importlib.metadata.version("hinfnav")``).
 
-    In a checkout the version is recomputed from the repository (setuptools-scm: the last tag
-    ``vX.Y.Z``, then ``X.Y.(Z+1).devN+g<commit>`` N commits after it, ``.d<date>`` when the tree is
-    dirty), so an editable install reports the commit it runs, not the one it was installed at.
+    The number is set in ``pyproject.toml`` (setuptools-scm: ``fallback_version`` with the
+    ``only-version`` scheme, so a checkout without tags installs as that release, e.g. ``0.3.0``);
+    the commit an output was made at is recorded beside it (:func:`git_commit`), so the version
+    carries no commit suffix. ``"unknown"`` when hinfnav runs from a source tree that was never
+    installed.
     """
-    root = _source_root()
-    if (root / ".git").exists():
-        try:
-            from setuptools_scm import get_version  # optional at run time; the build uses it
-
-            return get_version(root=str(root), version_scheme="guess-next-dev", local_scheme="node-and-date")
-        except Exception:
-            pass
     try:
         return metadata.version("hinfnav")
     except metadata.PackageNotFoundError:  # pragma: no cover - running from a bare source tree

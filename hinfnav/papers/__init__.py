@@ -2,7 +2,10 @@
 
 Each paper folder holds its constants, scenario, registered estimators,
 designs, studies, tables, figures and its ``reproduce``. Importing this
-package registers every paper's estimators.
+package loads no paper: a paper loads when it is first used (``hinfnav.papers.yang2020``
+imports that paper alone), and :func:`register` (called by the registry through the
+``hinfnav.providers`` entry point, and by :func:`reproduce`) imports every paper, registering
+their estimators and scenarios in one fixed order.
 
 =========  ====================================================================
 key        paper
@@ -23,6 +26,8 @@ benchmark     every registered estimator on every scenario where it fits, run as
 =========  ====================================================================
 """
 
+import importlib
+import importlib.util
 import inspect
 from pathlib import Path
 
@@ -30,21 +35,61 @@ from ..core.exceptions import InputError
 from ..core.validation import check_keywords
 from ..io.outputs import MARKER, atomic_output_dir
 from ..io.processes import check_jobs, one_blas_thread, run_jobs
-from . import attitude2018, benchmark, grace2010, shi2018, sun2011, yang2020
+__all__ = ["PAPERS", "SELECTIONS", "COST_S", "register", "reproduce", "sun2011", "shi2018", "attitude2018", "yang2020",
+           "grace2010", "benchmark"]
 
-__all__ = ["PAPERS", "SELECTIONS", "COST_S", "reproduce", "sun2011", "shi2018", "attitude2018", "yang2020", "grace2010", "benchmark"]
+#: A paper's modules that register campaign scenarios and estimators as they are imported.
+REGISTERING_MODULES = ("campaign", "filters")
+#: The paper sub-packages, in the order :func:`register` imports them (the registration order).
+PAPER_PACKAGES = ("attitude2018", "benchmark", "grace2010", "shi2018", "sun2011", "yang2020")
+
+
+def register():
+    """Import every paper (registering its estimators and campaign scenarios), in :data:`PAPER_PACKAGES` order.
+
+    The registry calls this through the ``hinfnav.providers`` entry point (``hinfnav.papers``: see
+    :func:`hinfnav.estimators.registry.load_providers`) on its first query; importing one paper
+    registers only that paper's names.
+    """
+    for name in PAPER_PACKAGES:
+        package = importlib.import_module(f".{name}", __name__)
+        for module in REGISTERING_MODULES:  # a lazy paper (yang2020) registers only when these load
+            if importlib.util.find_spec(f"{package.__name__}.{module}") is not None:
+                importlib.import_module(f"{package.__name__}.{module}")
+
+
+def __getattr__(name):
+    if name in PAPER_PACKAGES:  # a paper loads on first use (importing it sets it as an attribute)
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class _PaperReproduce:
+    """A paper's ``reproduce``, loaded when called (every paper registered first) or inspected; picklable."""
+
+    def __init__(self, key):
+        self.key = key
+
+    def _function(self):
+        register()
+        return importlib.import_module(f".{self.key}", __name__).reproduce
+
+    @property
+    def __signature__(self):
+        return inspect.signature(self._function())
+
+    def __call__(self, *args, **kwargs):
+        return self._function()(*args, **kwargs)
+
+    def __repr__(self):
+        return f"<reproduce of hinfnav.papers.{self.key}>"
+
 
 #: Reproducible papers: key -> its ``reproduce(out_dir, seed=, runs=, notebooks=, progress=)``.
 #: The primary paper (sun2011) writes into the output folder itself, as it always has;
 #: the others will write into ``<out>/<key>/``.
-PAPERS = {
-    "sun2011": sun2011.reproduce,
-    "shi2018": shi2018.reproduce,
-    "attitude2018": attitude2018.reproduce,
-    "yang2020": yang2020.reproduce,
-    "grace2010": grace2010.reproduce,
-    "benchmark": benchmark.reproduce,
-}
+PAPERS = {key: _PaperReproduce(key) for key in ("sun2011", "shi2018", "attitude2018", "yang2020", "grace2010",
+                                                 "benchmark")}
 
 #: Named selections: ``papers`` (the default of ``reproduce``) is the four papers and the GRACE real-data
 #: study; ``all`` adds the cross-paper benchmark campaign.
@@ -90,6 +135,7 @@ def reproduce(paper="papers", out_dir="results", *, jobs=None, **options):
     """
     if not isinstance(paper, str) or (paper not in SELECTIONS and paper not in PAPERS):
         raise InputError(f"unknown paper {paper!r}; choose one of: {', '.join(SELECTIONS)}, {', '.join(PAPERS)}")
+    register()
     jobs = check_jobs(jobs)
     keys = list(SELECTIONS[paper]) if paper in SELECTIONS else [paper]
     if options.get("runs", 0) is None:

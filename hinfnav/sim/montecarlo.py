@@ -67,13 +67,13 @@ def run_estimator(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P0: A
 
 def simulate_batches(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
                      measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0,
-                     batch_size: int = 100, progress: bool = False, diagnostics: bool | Sequence[str] = False,
+                     batch_size: int = 100, diagnostics: bool | Sequence[str] = False,
                      keep_covariance: bool | str = True, **conditions: Any) -> Iterator[tuple[int, SimulationResult]]:
     """Yield ``(first_run, SimulationResult)`` batch by batch: histories of ``batch_size`` runs at a time.
 
     Memory is that of one batch, whatever ``runs``; the numbers of run r do not
     depend on the batch size (run r always draws from the r-th child generator).
-    Arguments as in :func:`simulate`. (The engine's pull form: :func:`hinfnav.sim.engine.truth_batches`
+    Arguments as in :func:`simulate` (no ``progress``: nothing here is long enough to show one). (The engine's pull form: :func:`hinfnav.sim.engine.truth_batches`
     and :func:`~hinfnav.sim.engine.estimate_on_truth`.)
     """
     estimator = resolve_estimator(scenario, estimator)

@@ -17,6 +17,7 @@ from .hill import (
 from .dynamics import ConstantTurn, ContinuousDynamics, DiscreteDynamics, DynamicsModel, constant_turn_state_spec
 from .linear import LinearSystem
 from .measurements import (
+    ConvertedPosition,
     LinearMeasurement,
     MeasurementModel,
     RangeAzimuthElevation,
@@ -37,6 +38,7 @@ from .uncertain import UncertainSystem
 from .timed import TimedReadings, TimedSystem, merge_readings, read_timed_csv
 
 __all__ = [
+    "ConvertedPosition",
     "StateSpec",
     "chaser_state_spec",
     "LinearSystem",

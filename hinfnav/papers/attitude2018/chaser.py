@@ -215,7 +215,7 @@ SWEEPS = (("plain", "q_plain", "Q_input", Q_THRUST, (1.0, 10.0, 100.0, 1e3, 1e4,
           ("adaptive", "epsilon_adaptive", "epsilon", THRUST_EPSILON, (0.03, 0.1, 0.3, 1.0, 3.0)))
 
 
-def chaser_study(scenario=None, *, runs=20, seed=0, sweep_runs=None, progress=False):
+def chaser_study(scenario=None, *, runs=20, seed=0, sweep_runs=None):
     """Item 5: the paper's unaware EKF, the EKF told the thrust and the three thrust-augmented filters.
 
     Parameters

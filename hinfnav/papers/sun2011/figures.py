@@ -114,7 +114,7 @@ def figure_errors(result, title, *, run=0, t_zoom_from=5.0, size="default", inse
     return fig
 
 
-def paper_runs(scenario=None, *, seed=0, progress=False):
+def paper_runs(scenario=None, *, seed=0):
     """The single runs behind Figs 2–6: each filter with and without maneuver.
 
     Returns

@@ -9,38 +9,43 @@ Algorithms 1-3 of :mod:`hinfnav.estimators.extended_state`), the closed loop
 (:mod:`.claims`), Figs 5-12 (:mod:`.figures`) and ``reproduce``.
 """
 
-from .campaign import CampaignScenario
-from .claims import evaluate_claims, format_claims
-from .constants import CITATION, READING_REASONS, READINGS, REQUIREMENT_ASD, TABLE2
-from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12, plot_asd, plot_series, plot_truncated_update
-from .filters import ESTIMATOR_NAMES, L_MODES, SUBSYSTEM_OF, build_alg1, build_alg2, build_fused
-from .loop import PASSIVE, LoopResult, residual_acceleration, run_closed_loop, run_closed_loops
-from .model import (
-    DRAGFREE_INDICES,
-    DragFreeModel,
-    disturbance,
-    drag_free_model,
-    dragfree_state_spec,
-    extended_state_spec,
-    increment_bounds,
-    noise_std,
-    omega_d,
-    plant_state_spec,
-)
-from .reproduce import READING_RUNS, algorithm_windows, integral_study, reading_study, reproduce
-from .scenario import CONTROLLERS, SUBSYSTEMS, Scenario
-from .studies import (
-    NPERSEG,
-    amplitude_spectral_density,
-    band_statistics,
-    disturbance_errors,
-    estimation_errors,
-    linear_loop_radius,
-    periodic_amplitude,
-    residual_spectrum,
-    saturation_summary,
-    step_response,
-)
+from typing import TYPE_CHECKING
+
+from ...core.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the lazy exports (each module loads on first use: importing the paper loads no figure or solver)
+    from .campaign import CampaignScenario
+    from .claims import evaluate_claims, format_claims
+    from .constants import CITATION, READING_REASONS, READINGS, REQUIREMENT_ASD, TABLE2
+    from .figures import fig5, fig6, fig7, fig8, fig9, fig10, fig11, fig12, plot_asd, plot_series, plot_truncated_update
+    from .filters import ESTIMATOR_NAMES, L_MODES, SUBSYSTEM_OF, build_alg1, build_alg2, build_fused
+    from .loop import PASSIVE, LoopResult, residual_acceleration, run_closed_loop, run_closed_loops
+    from .model import (
+        DRAGFREE_INDICES,
+        DragFreeModel,
+        disturbance,
+        drag_free_model,
+        dragfree_state_spec,
+        extended_state_spec,
+        increment_bounds,
+        noise_std,
+        omega_d,
+        plant_state_spec,
+    )
+    from .reproduce import READING_RUNS, algorithm_windows, integral_study, reading_study, reproduce
+    from .scenario import CONTROLLERS, SUBSYSTEMS, Scenario
+    from .studies import (
+        NPERSEG,
+        amplitude_spectral_density,
+        band_statistics,
+        disturbance_errors,
+        estimation_errors,
+        linear_loop_radius,
+        periodic_amplitude,
+        residual_spectrum,
+        saturation_summary,
+        step_response,
+    )
 
 __all__ = [
     "CampaignScenario",
@@ -102,3 +107,5 @@ __all__ = [
     "integral_study",
     "algorithm_windows",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__)

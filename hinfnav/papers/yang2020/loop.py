@@ -253,13 +253,13 @@ class _FusedGroups:
             grp[2] = grp[1].start(grp[4], None, grp[0].stop - grp[0].start)
 
     def update(self, k, y, u_read):
-        # the filters' hooks: the loop's readings and inputs are float arrays of the right shapes, their
-        # finiteness checked once after the loop (:func:`run_closed_loops`), as ``Estimator.estimate`` does
+        # the filters' unchecked steps: the loop's readings and inputs are float arrays of the right shapes,
+        # their finiteness checked once after the loop (:func:`run_closed_loops`), as ``Estimator.estimate`` does
         one = self.one
         for grp in self.groups:
             sl, fused, fs = grp[0], grp[1], grp[2]
-            fs = fused._feed_input(fs, u_read if one else u_read[sl])
-            fs, out = fused._update(fs, y if one else y[sl])
+            fs = fused.feed_input_unchecked(fs, u_read if one else u_read[sl])
+            fs, out = fused.update_unchecked(fs, y if one else y[sl])
             grp[2] = fs
             if one:
                 xhat = out.xhat
@@ -275,7 +275,7 @@ class _FusedGroups:
     def predict(self, k, u):
         one = self.one
         for grp in self.groups:
-            grp[2] = grp[1]._predict(grp[2], u if one else u[grp[0]])
+            grp[2] = grp[1].predict_unchecked(grp[2], u if one else u[grp[0]])
 
 
 class _Law:
@@ -318,9 +318,9 @@ class _Passive:
         p, h, prow = self.plant, self.h, self.prow
         Yp, up_, ur, ar, ac = ((p.Y, u, u_read, p.a_raw, p.a_c) if self.all else
                                (p.Y[prow], u[prow], u_read[prow], p.a_raw[prow], p.a_c[prow]))
-        self.s1, o1 = self.a1._update(self.s1, Yp)  # the hooks, as in :class:`_FusedGroups`
+        self.s1, o1 = self.a1.update_unchecked(self.s1, Yp)  # unchecked, as in :class:`_FusedGroups`
         h["alg1"][:, k] = o1.xhat[:, 9:18]
-        self.s1 = self.a1._predict(self.s1, up_)
+        self.s1 = self.a1.predict_unchecked(self.s1, up_)
         h["L1"][:, k], h["L2"][:, k], h["L3"][:, k] = self.bank.step(ar, ac, ur[:, 3:6], up_[:, 3:6])
 
 
