@@ -53,7 +53,7 @@ its own, and the existence condition ``N_k > 0`` is checked per run.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -297,7 +297,8 @@ class ExtendedHInfinityFilter(ExtendedKalmanFilter):
         Sbar = self.L.T @ self.S @ self.L
         self.Sbar = 0.5 * (Sbar + Sbar.T)
 
-    def correct_error(self, P, H, R, innovation):
+    def correct_error(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
+                      innovation: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """(X1): ``(δx, P̄, diagnostics)`` batched (P, H, R shared or per run)."""
         HtRi = np.swapaxes(np.linalg.solve(R, H), -1, -2)  # Hᵀ R⁻¹, (…, n, m)
         G = HtRi @ H - self.theta * self.Sbar
