@@ -46,7 +46,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.exceptions import InputError
+from ..core.exceptions import FilterDivergedError, InputError, ModelFunctionError
 from ..core.validation import as_choice, as_int_at_least, as_vector
 from .compiled import run_compiled, select_backend
 
@@ -56,7 +56,11 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "store_diagnostics", "MISSING", "PHASES", "available_channels"]
+           "store_diagnostics", "MISSING", "PHASES", "READING_LIMIT", "available_channels"]
+
+#: Largest |reading| a filter accepts: beyond it a squared innovation (an innovation moment, a Huber weight, a
+#: converted range) overflows double precision, and the NumPy and compiled paths would fail differently.
+READING_LIMIT = 1e150
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
@@ -213,6 +217,7 @@ def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, 
     elif not np.all(np.isfinite(y)):
         raise InputError("y (the measurements) must contain only finite numbers; it has NaN or inf entries "
                          "(a filter built with missing='skip' skips NaN channels)")
+    _check_reading_size(y, "y (the measurements)")
     u = np.asarray(u, dtype=float)
     if u.ndim != 3 or u.shape[:2] != y.shape[:2]:
         raise InputError(f"u must have shape (runs, n_samples, n_input) matching y {y.shape[:2]}; got {u.shape}")
@@ -222,6 +227,13 @@ def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, 
         raise InputError("u (the inputs) must contain only finite numbers; it has NaN or inf entries")
     xhat0 = as_vector("xhat0", xhat0, n_state)
     return y, u, xhat0
+
+
+def _check_reading_size(y, what):
+    big = np.nanmax(np.abs(y), initial=0.0)
+    if big > READING_LIMIT:
+        raise InputError(f"{what} has an entry of magnitude {big:.3g}, beyond {READING_LIMIT:g}: its square overflows "
+                         "double precision inside a filter (check the units, or the reading is corrupt)")
 
 
 class Estimator:
@@ -330,7 +342,12 @@ class Estimator:
         elif not np.isfinite(y).all():
             raise InputError(f"filter {self.name!r}: y at step {k} must contain only finite numbers; it has NaN or "
                              "inf entries (build the filter with missing='skip' to skip NaN channels)")
-        new, out = self._update(state, y)
+        _check_reading_size(y, f"filter {self.name!r}: y at step {k}")
+        try:
+            new, out = self._update(state, y)
+        except ModelFunctionError as exc:
+            raise exc.at_step(k) from exc.__cause__
+        self._check_finite(out, k)
         return self._phase(new, state, "posterior"), out
 
     def predict(self, state: FilterState, u: ArrayLike | None = None) -> FilterState:
@@ -341,7 +358,11 @@ class Estimator:
         """
         self._check_order(state, "predict", "posterior")
         u = self._check_step_input(state, u, "predict")
-        return self._phase(self._predict(state, u), state, "prior")
+        try:
+            new = self._predict(state, u)
+        except ModelFunctionError as exc:
+            raise exc.at_step(state.k) from exc.__cause__
+        return self._phase(new, state, "prior")
 
     def step(self, state: FilterState, y: ArrayLike, u: ArrayLike | None = None) -> tuple[FilterState, StepOutput]:
         """``update`` with y_k, then ``predict`` with u_k; returns ``(state, StepOutput)``."""
@@ -383,6 +404,19 @@ class Estimator:
         ``predict`` checks u, between ``start``/``predict`` and ``update``."""
         self._check_order(state, "feed_input", "prior")
         return self._check_step_input(state, u, "feed_input")
+
+    def _check_finite(self, out, k):
+        """The non-finite policy: an estimate or covariance with NaN or inf raises :class:`FilterDivergedError`.
+
+        Every path does this at the step where it happens (the compiled one by handing a non-finite batch back
+        to this loop), so the NumPy and numba backends refuse the same inputs. A skipped reading leaves the
+        prior, which is finite; NaN marks nothing else in an estimate.
+        """
+        if not np.isfinite(out.xhat).all() or (out.P is not None and not np.isfinite(out.P).all()):
+            what = "estimate" if not np.isfinite(out.xhat).all() else "covariance"
+            raise FilterDivergedError(f"filter {self.name!r} diverged at step {k}: its {what} is not finite (NaN or "
+                                      "inf; readings or a model too large for double precision, or an unstable "
+                                      "filter)")
 
     @staticmethod
     def _phase(new, old, phase):
@@ -443,32 +477,38 @@ class Estimator:
                                              self.n_input if self.uses_input else None, self.missing)
         if select_backend(self, backend, keys) == "numba":
             xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
-            if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says
+            if xhat is not None and np.isfinite(xhat).all() and (P_hist is None or np.isfinite(P_hist).all()):
+                # else a factorisation failed or a number is not finite: the NumPy path raises at its step
                 return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks
         xhat = np.empty((runs, n1, self.n_state))
         P_hist, shared, diag = None, False, {}
-        for k in range(n1):
-            state, out = self._update(state, y[:, k])
-            xhat[:, k] = out.xhat
-            if keep_covariance and out.P is not None:
-                P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
-                if P_hist is None:
-                    # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
-                    shared = P.ndim == core or P.strides[0] == 0
-                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
-                if shared and not (P.ndim == core or P.strides[0] == 0):
-                    # a skipped channel in some runs only: the covariance becomes per run from here on
-                    P_hist, shared = np.broadcast_to(P_hist, (runs,) + P_hist.shape).copy(), False
-                if shared:
-                    P_hist[k] = P if P.ndim == core else P[0]
-                else:
-                    P_hist[:, k] = P
-            store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
-            if k < n1 - 1:
-                state = self._predict(state, u[:, k])
+        k = 0
+        try:
+            for k in range(n1):
+                state, out = self._update(state, y[:, k])
+                self._check_finite(out, k)
+                xhat[:, k] = out.xhat
+                if keep_covariance and out.P is not None:
+                    P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
+                    if P_hist is None:
+                        # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
+                        shared = P.ndim == core or P.strides[0] == 0
+                        P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
+                    if shared and not (P.ndim == core or P.strides[0] == 0):
+                        # a skipped channel in some runs only: the covariance becomes per run from here on
+                        P_hist, shared = np.broadcast_to(P_hist, (runs,) + P_hist.shape).copy(), False
+                    if shared:
+                        P_hist[k] = P if P.ndim == core else P[0]
+                    else:
+                        P_hist[:, k] = P
+                store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
+                if k < n1 - 1:
+                    state = self._predict(state, u[:, k])
+        except ModelFunctionError as exc:
+            raise exc.at_step(k) from exc.__cause__
         if shared:
             P_hist.setflags(write=False)
             P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
