@@ -135,3 +135,13 @@ def test_user_subclasses_are_checked():
 
     with pytest.raises(ModelFunctionError, match=r"measurement model Range: jacobian\(x\) disagrees .* entry \[0, 0\]"):
         run(DiscreteDynamics(good_f, SPEC, DT, Q), sensor=Range())
+
+
+def test_noise_matrices_checked_whenever_set():
+    ekf = ExtendedKalmanFilter(DiscreteDynamics(good_f, SPEC, DT, Q), SENSOR, P0=np.eye(2))
+    ekf.Q = 0.02 * np.eye(2)  # a valid new value is kept
+    np.testing.assert_array_equal(ekf.Q, 0.02 * np.eye(2))
+    for name, bad, words in [("Q", -np.eye(2), "semidefinite"), ("R", [[0.0]], "positive definite"),
+                             ("P0", np.ones((3, 3)), "shape 2x2"), ("Q", [[1.0, np.nan], [0, 1]], "finite")]:
+        with pytest.raises(InputError, match=f"ExtendedKalmanFilter.{name}.*{words}"):
+            setattr(ekf, name, bad)

@@ -47,6 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import FilterDivergedError, InputError, ModelFunctionError
+from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_int_at_least, as_vector
 from .compiled import run_compiled, select_backend
 
@@ -259,6 +260,27 @@ class Estimator:
     name = "estimator"
     uses_input = False
     vectorized = True
+    #: the noise matrices checked whenever they are set again after construction (name → must be definite)
+    checked_covariances = {"Q": False, "R": True, "P0": True}
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        """Q, R and P0 set after construction are checked as the constructor checks them (issue 36).
+
+        A new value must be a finite symmetric matrix of the size the filter was built with, positive
+        semidefinite (Q) or definite (R, P0); a per-run or per-step stack (3-D) keeps its shape.
+        """
+        old = self.__dict__.get(name) if name in self.checked_covariances else None
+        if old is not None and value is not None:
+            old_arr = np.asarray(old)
+            if old_arr.ndim == 2:
+                value = as_covariance(f"{type(self).__name__}.{name}", value, old_arr.shape[0],
+                                      definite=self.checked_covariances[name])
+            else:
+                arr = np.asarray(value, dtype=float)
+                if arr.shape != old_arr.shape or not np.isfinite(arr).all():
+                    raise InputError(f"{type(self).__name__}.{name} must be a finite array of shape {old_arr.shape}; "
+                                     f"got shape {arr.shape}")
+        object.__setattr__(self, name, value)
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, name: str | None = None,
                  missing: str = "refuse") -> None:
