@@ -258,6 +258,11 @@ class Campaign:
                 raise InputError(f"estimator_options.{key} must be a table of options; got {opts!r}")
             canonical(opts)
         set_("estimator_options", {str(k): dict(v) for k, v in self.estimator_options.items()})
+        in_grid = self.grid["estimator"]
+        stray = sorted(set(self.estimator_options) - set(registered_estimators() if "all" in in_grid else in_grid))
+        if stray:  # options for an estimator the grid does not run: a misspelt name, never silently ignored
+            raise InputError(f"estimator_options.{stray[0]}: {stray[0]!r} is not an estimator of the grid "
+                             f"({', '.join(map(str, in_grid))}); options apply only to estimators the grid runs")
         object.__setattr__(self, "_cells", None)
         object.__setattr__(self, "_sizes", ())
         object.__setattr__(self, "_tried", ())

@@ -507,6 +507,7 @@ class Estimator:
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks
         xhat = np.empty((runs, n1, self.n_state))
         P_hist, shared, diag = None, False, {}
+        produced = set()
         k = 0
         try:
             for k in range(n1):
@@ -527,10 +528,15 @@ class Estimator:
                     else:
                         P_hist[:, k] = P
                 store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
+                if keys:
+                    produced.update(out.diagnostics)
                 if k < n1 - 1:
                     state = self._predict(state, u[:, k])
         except ModelFunctionError as exc:
             raise exc.at_step(k) from exc.__cause__
+        if keys and keys - produced:  # a name asked for that this filter never reports: refused, not ignored
+            raise InputError(f"unknown diagnostic {', '.join(map(repr, sorted(keys - produced)))} for filter "
+                             f"{self.name!r}; it reports: {', '.join(sorted(produced)) or 'none'}")
         if shared:
             P_hist.setflags(write=False)
             P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)

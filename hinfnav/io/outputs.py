@@ -27,7 +27,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 
-__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
+__all__ = ["dumps_strict", "MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
            "write_json"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
@@ -163,8 +163,17 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
     return path
 
 
-def write_json(path: str | os.PathLike, obj: Any, *, strict: bool = False) -> Any:
-    """Write ``to_json(obj, strict=strict)`` to ``path`` atomically (indented, newline at the end); return it."""
+def dumps_strict(obj: Any, **kwargs: Any) -> str:
+    """``json.dumps`` of ``to_json(obj, strict=True)``: strict JSON, NaN and infinities as null (issue 36)."""
+    return json.dumps(to_json(obj, strict=True), allow_nan=False, **kwargs)
+
+
+def write_json(path: str | os.PathLike, obj: Any, *, strict: bool = True) -> Any:
+    """Write ``to_json(obj, strict=strict)`` to ``path`` atomically (indented, newline at the end); return it.
+
+    Strict JSON by default (NaN and infinities as null, which every JSON reader accepts); ``strict=False``
+    keeps Python's ``NaN``/``Infinity`` tokens, for a reader that needs them.
+    """
     data = to_json(obj, strict=strict)
-    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
+    atomic_write_text(path, json.dumps(data, indent=2, allow_nan=not strict) + "\n")
     return data

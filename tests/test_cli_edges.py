@@ -1,0 +1,56 @@
+"""Command-line edges and strict outputs (issue 36, items 7 and 8).
+
+Expected: exit status 2 and one line naming the option for an option that does
+not apply; 130 and one line for Ctrl-C; strict JSON (no NaN/Infinity tokens,
+parsed with a ``parse_constant`` that refuses them) for every JSON writer.
+"""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from hinfnav import cli
+from hinfnav.io.outputs import dumps_strict, write_json
+
+
+def _refuse(token):
+    raise AssertionError(f"non-strict JSON token {token}")
+
+
+def test_version_flag():
+    out = subprocess.run([sys.executable, "-m", "hinfnav", "--version"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.startswith("hinfnav ")
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["design", "--system", "examples/double_integrator.toml", "--delta-bar", "0.1"], "--delta-bar does not apply"),
+    (["design", "--system", "examples/double_integrator.toml", "--points", "5"], "--points does not apply"),
+    (["design", "--recertify", "d.json", "--solver", "SCS"], "--solver does not apply"),
+    (["design", "--recertify", "d.json", "--form", "observer"], "--form does not apply"),
+])
+def test_design_options_that_do_not_apply_are_refused(argv, words, capsys):
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1
+
+
+def test_ctrl_c_is_one_line(monkeypatch, capsys):
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_cmd_reproduce", interrupted)
+    assert cli.main(["reproduce", "--paper", "sun2011", "--out", "nowhere"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "interrupted" in err[0]
+
+
+def test_json_writers_are_strict(tmp_path):
+    data = {"rms": np.array([1.0, np.nan]), "worst": float("inf"), "n": np.int64(3)}
+    path = tmp_path / "s.json"
+    write_json(path, data)
+    back = json.loads(path.read_text(), parse_constant=_refuse)
+    assert back == {"rms": [1.0, None], "worst": None, "n": 3}
+    assert json.loads(dumps_strict(data), parse_constant=_refuse) == back
