@@ -56,12 +56,12 @@ import json
 import math
 import numbers
 import os
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..core.tomlfile import read_toml
 from ..core.exceptions import InputError
 from ..estimators.registry import estimator_entry, fit_reason, registered_estimators
 from ..noise import NOISE_NAMES
@@ -482,13 +482,6 @@ def load_campaign(spec: Campaign | Mapping[str, Any] | str | os.PathLike[str]) -
         path = Path(spec).expanduser()
         if not path.is_file():
             raise InputError(f"spec: no campaign file at {path}")
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise InputError(f"spec: {path} is not valid TOML ({exc})") from None
-        except UnicodeDecodeError as exc:
-            raise InputError(f"spec: {path} is not UTF-8 text, as TOML requires (byte {exc.object[exc.start]:#04x} "
-                             f"at offset {exc.start}); save it as UTF-8 (it may be Latin-1 or Windows-1252)") from None
+        data = read_toml(path, "spec: campaign file")  # names a BOM, an encoding, invalid TOML, a key given twice
         return Campaign.from_dict(data, source=f"spec {path.name}")
     raise InputError(f"spec must be a Campaign, a dict or the path of a TOML file; got {type(spec).__name__}")
