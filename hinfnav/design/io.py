@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..io.outputs import atomic_write_text
 from ..io.provenance import provenance
 from ..core.validation import as_path, check_new_file
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
@@ -236,10 +237,7 @@ def save_design(result: SynthesisResult | PolytopicResult, system: UncertainSyst
     """Write a design file (JSON); returns the path. The file is written whole or not at all."""
     path = check_design_path(path)
     text = json.dumps(design_to_dict(result, system, options=options, extra=extra), indent=2) + "\n"
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return atomic_write_text(path, text)  # whole or nothing; no temporary file left on a failure
 
 
 def load_design(path: str | os.PathLike[str]) -> tuple[SynthesisResult | PolytopicResult, UncertainSystem | PolytopicSystem,
