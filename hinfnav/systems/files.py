@@ -117,6 +117,10 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
                     raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
                                      f"{', '.join(MATRIX_KEYS)}")
             verts = [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
+            try:  # [nominal] must be a system on its own, even where every vertex replaces one of its matrices
+                UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=dt)
+            except InputError as exc:
+                raise InputError(f"[nominal]: {exc}") from None
             return PolytopicSystem.from_matrices(mats, verts, dt)
         raise InputError(f"[uncertainty] key 'kind' must be \"norm-bounded\" or \"polytope\"; got {kind!r}")
     except InputError as exc:
