@@ -80,7 +80,7 @@ def _model_cases():
     def reference(make, runs, jac=None):
         return run(DiscreteDynamics(lambda x, u, t: x @ F.T, spec, dt, Q, jacobian=jac), make, runs)
 
-    good_f = lambda x, u, t: x @ F.T  # noqa: E731
+    good_f = lambda x, u, t: x @ F.T
     bad_f = {
         "f transposed (n, runs)": (lambda x, u, t: (x @ F.T).T, ["f(x, u, t)"]),
         "f returns (runs, 1)": (lambda x, u, t: x[:, :1], ["f(x, u, t)", "shape"]),
@@ -143,7 +143,7 @@ def _model_cases():
             case("user model", f"{fname} runs={runs}: correct f and Jacobian", "valid")(check_good)
 
     # continuous derivatives
-    a_ok = lambda x, u, t: np.column_stack([x[:, 1], -x[:, 0]])  # noqa: E731
+    a_ok = lambda x, u, t: np.column_stack([x[:, 1], -x[:, 0]])
     A = np.array([[0.0, 1.0], [-1.0, 0.0]])
     bad_a = {
         "derivative (runs, 1)": (lambda x, u, t: x[:, 1:2], ["derivative", "shape"]),
@@ -197,8 +197,8 @@ def _model_cases():
             attrs["jacobian"] = lambda self, x: jacobian(x)
         return type("UserSensor", (MeasurementModel,), attrs)()
 
-    h_ok = lambda x: x[..., :1] ** 2 / 2  # noqa: E731
-    H_ok = lambda x: np.concatenate([x[..., :1], np.zeros_like(x[..., :1])], axis=-1)[..., None, :]  # noqa: E731
+    h_ok = lambda x: x[..., :1] ** 2 / 2
+    H_ok = lambda x: np.concatenate([x[..., :1], np.zeros_like(x[..., :1])], axis=-1)[..., None, :]
     bad_h = {
         "h returns (runs,)": (lambda x: x[..., 0], H_ok, ["function h", "shape"]),
         "h returns (runs, 2)": (lambda x: x, H_ok, ["function h", "shape"]),
@@ -570,7 +570,7 @@ def classify(c, timeout):
         err = None
     except _Timeout:
         return "hang", f"no answer in {timeout} s"
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - classified below
+    except (Exception, SystemExit) as exc:
         err = exc
     finally:
         signal.alarm(0)
