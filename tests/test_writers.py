@@ -57,3 +57,21 @@ def test_destinations_refused_before_any_work(tmp_path, monkeypatch):
         check_new_file("--save", tmp_path / "d.json")
     with pytest.raises(InputError, match="cannot write in .*Read-only file system"):
         check_output_dir(tmp_path / "new" / "out")
+
+
+def test_worker_start_failure_is_one_line(monkeypatch):
+    import distributed
+
+    from hinfnav.campaign.runner import _open_client
+    from hinfnav.core.exceptions import HinfnavError
+
+    def dead(*args, **kwargs):
+        try:
+            raise OSError("worker process exited with code -9")
+        except OSError as exc:
+            raise RuntimeError("Nanny failed to start.") from exc
+
+    monkeypatch.setattr(distributed, "LocalCluster", dead)
+    with pytest.raises(HinfnavError, match=r"did not start .*Nanny failed to start.*exited with code -9") as info:
+        _open_client(None, 2, 5.0)
+    assert "\n" not in str(info.value)

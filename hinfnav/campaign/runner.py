@@ -255,8 +255,16 @@ def _open_client(client, workers, connect_timeout):
 
     if client is None:
         n = workers if workers is not None else (os.cpu_count() or 1)
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               silence_logs=logging.ERROR)
+        try:
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                   silence_logs=logging.ERROR)
+        except KeyboardInterrupt:
+            raise
+        except Exception as exc:  # "Nanny failed to start" and the like: one line, the cause named
+            cause = exc.__cause__ or exc.__context__ or exc
+            raise HinfnavError(f"the local Dask cluster did not start ({n} worker processes): {type(exc).__name__}: "
+                               f"{exc} (cause: {type(cause).__name__}: {cause}); a worker killed or out of memory "
+                               "while starting? try again, or with fewer --workers") from None
         return Client(cluster), True
     if isinstance(client, str):
         try:
