@@ -384,7 +384,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         # one line, no traceback: the writers publish a folder or file only when complete (atomic), so an
         # interrupted run leaves no partial output behind
-        print("interrupted (Ctrl-C): stopped; no partial output was written", file=sys.stderr)
+        print("interrupted (Ctrl-C): stopped; nothing half-written is left (a campaign keeps its finished cells: run it again to resume)", file=sys.stderr)
         return 130
     except BrokenPipeError:
         # output piped into e.g. `head`, which closed early: not an error of ours

@@ -54,3 +54,34 @@ def test_json_writers_are_strict(tmp_path):
     back = json.loads(path.read_text(), parse_constant=_refuse)
     assert back == {"rms": [1.0, None], "worst": None, "n": 3}
     assert json.loads(dumps_strict(data), parse_constant=_refuse) == back
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_a_campaign_is_one_line(tmp_path):
+    # a real campaign on a LocalCluster of 2 workers, interrupted after its start: the workers ignore Ctrl-C
+    # (they start with it ignored), the command stops in one line with status 130
+    import os
+    import signal
+    import time
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = tmp_path / "c.toml"
+    spec.write_text('runs = 20000\nbatch_size = 50\n[grid]\nscenario = "sun2011"\nestimator = ["ekf", "published"]\n'
+                    'duration_s = [100.0]\nrms_window_s = [[0, 100.0]]\n[windows]\nall = [0, 100.0]\n')
+    env = dict(os.environ, PYTHONPATH=str(root), MPLBACKEND="Agg")
+    proc = subprocess.Popen([sys.executable, "-m", "hinfnav", "campaign", str(spec), "--out", str(tmp_path / "out"),
+                             "--workers", "2"], cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    import psutil
+
+    deadline = time.monotonic() + 120  # until the cluster is up: 2 nannies and their 2 workers
+    while len(psutil.Process(proc.pid).children(recursive=True)) < 4 and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(5.0)
+    os.killpg(proc.pid, signal.SIGINT)  # what the terminal does: the whole process group
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    ours = [line for line in err.splitlines() if "resource_tracker" not in line and "warnings.warn" not in line]
+    # multiprocessing's resource tracker may add its own 2-line leak warning (a semaphore of the stopped cluster)
+    assert len(ours) == 1 and "interrupted" in ours[0] and "Traceback" not in err, err

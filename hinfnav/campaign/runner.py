@@ -38,6 +38,8 @@ import importlib
 import json
 import logging
 import os
+import signal
+import threading
 import time
 from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
@@ -249,6 +251,10 @@ def _read_cell(path, cell_id):
     return data
 
 
+def _main_thread():
+    return threading.current_thread() is threading.main_thread()
+
+
 def _open_client(client, workers, connect_timeout):
     """``(client, owned)``: the client to use and whether this call made it (and must close it)."""
     from distributed import Client, LocalCluster  # heavy optional library: imported when a campaign runs
@@ -256,8 +262,16 @@ def _open_client(client, workers, connect_timeout):
     if client is None:
         n = workers if workers is not None else (os.cpu_count() or 1)
         try:
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                   silence_logs=logging.ERROR)
+            # the worker processes start with Ctrl-C ignored (an ignored signal stays ignored in a child): a Ctrl-C
+            # then reaches this process alone, which stops the campaign in one line and closes the cluster, instead
+            # of every worker printing its own traceback
+            previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            finally:
+                if previous is not None:
+                    signal.signal(signal.SIGINT, previous)
         except KeyboardInterrupt:
             raise
         except Exception as exc:  # "Nanny failed to start" and the like: one line, the cause named
