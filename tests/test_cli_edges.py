@@ -85,3 +85,14 @@ def test_ctrl_c_during_a_campaign_is_one_line(tmp_path):
     ours = [line for line in err.splitlines() if "resource_tracker" not in line and "warnings.warn" not in line]
     # multiprocessing's resource tracker may add its own 2-line leak warning (a semaphore of the stopped cluster)
     assert len(ours) == 1 and "interrupted" in ours[0] and "Traceback" not in err, err
+
+
+@pytest.mark.slow
+def test_reproduce_with_one_run_writes_strict_json(tmp_path):
+    # one run: the spread statistics are undefined (NaN), written as null (15 s of CPU)
+    from hinfnav.papers import reproduce
+
+    reproduce("sun2011", tmp_path / "r1", runs=1, jobs=1, progress=False)
+    text = (tmp_path / "r1" / "summary.json").read_text()
+    json.loads(text, parse_constant=_refuse)
+    assert "null" in text
