@@ -57,16 +57,19 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "store_diagnostics", "MISSING", "PHASES", "READING_LIMIT", "OPTIONAL_DIAGNOSTICS", "available_channels"]
+           "store_diagnostics", "MISSING", "PHASES", "READING_LIMIT", "KNOWN_DIAGNOSTICS", "available_channels"]
 
 #: Largest |reading| a filter accepts: beyond it a squared innovation (an innovation moment, a Huber weight, a
 #: converted range) overflows double precision, and the NumPy and compiled paths would fail differently.
 READING_LIMIT = 1e150
 
-#: Diagnostics the consistency statistics ask of every filter and use where reported (NIS): never refused when a
-#: filter does not report them (a fixed-gain filter has no innovation covariance). Any other name asked of
-#: :meth:`Estimator.estimate` that the filter does not report is refused (issue 36: never ignored).
-OPTIONAL_DIAGNOSTICS = ("innovation", "innovation_covariance")
+#: Every diagnostic name a hinfnav filter reports (collected over the registered estimators). A name asked of
+#: :meth:`Estimator.estimate` that is neither among these nor reported by the filter is refused (issue 36: a
+#: misspelt name is never ignored); a known name a filter does not report is left out, so one list can be asked
+#: of several filters (the consistency statistics ask every filter for the NIS inputs, a study for the weights).
+KNOWN_DIAGNOSTICS = ("converged", "existence_margin", "existence_ok", "fading", "fading_c", "innovation",
+                     "innovation_covariance", "input_estimate", "input_rate", "iterations", "q_adapted", "saturated",
+                     "theta", "theta_alg2", "weights")
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
@@ -539,7 +542,7 @@ class Estimator:
                     state = self._predict(state, u[:, k])
         except ModelFunctionError as exc:
             raise exc.at_step(k) from exc.__cause__
-        unknown = keys - produced - set(OPTIONAL_DIAGNOSTICS) if keys else set()
+        unknown = keys - produced - set(KNOWN_DIAGNOSTICS) if keys else set()
         if unknown:  # a name asked for that this filter never reports: refused, not ignored
             raise InputError(f"unknown diagnostic {', '.join(map(repr, sorted(unknown)))} for filter "
                              f"{self.name!r}; it reports: {', '.join(sorted(produced)) or 'none'}")
