@@ -2,6 +2,11 @@
 
 import sys
 
-from .cli import main
+try:
+    from .cli import main
 
-sys.exit(main())
+    status = main()
+except KeyboardInterrupt:  # Ctrl-C outside a command (while importing, or while a cluster closes): one line too
+    print("interrupted (Ctrl-C): stopped; nothing half-written is left (a campaign keeps its finished cells: run it again to resume)", file=sys.stderr)
+    status = 130
+sys.exit(status)

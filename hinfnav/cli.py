@@ -10,14 +10,13 @@ needs when it runs, so ``python -m hinfnav --help`` starts fast.
 
 import argparse
 import importlib
-import json
 import math
 import os
 import sys
 from collections.abc import Callable, Sequence
 
 from .core.exceptions import HinfnavError, InputError
-from .io.outputs import check_output_dir
+from .io.outputs import check_output_dir, dumps_strict
 from .core.validation import check_new_file
 
 __all__ = ["main", "simulate_report", "format_simulate_report", "RegistryChoices", "FILTER_CHOICES",
@@ -125,10 +124,36 @@ def _cmd_simulate(args):
     rep = simulate_report(args.filter, maneuver=not args.no_maneuver, delta=args.delta, noise=args.noise,
                           seed=args.seed, runs=args.runs, discretization=args.discretization,
                           progress=not args.json and args.runs > 1, design=args.design, verbatim=args.verbatim)
-    print(json.dumps(rep, indent=2) if args.json else format_simulate_report(rep))
+    print(dumps_strict(rep, indent=2) if args.json else format_simulate_report(rep))
+
+
+#: design options given on the command line only for the built-in scenario, with their defaults (issue 36: an
+#: option that does not apply is refused, not ignored)
+_DESIGN_DEFAULTS = {"delta_bar": 0.05, "points": 12, "form": "general", "objective": "hinf"}
+_FLAG = {"delta_bar": "--delta-bar", "points": "--points", "form": "--form", "objective": "--objective",
+         "solver": "--solver", "lyapunov": "--lyapunov", "gamma": "--gamma", "save": "--save"}
+
+
+def _check_design_options(args):
+    """Refuse the design options that do not apply to what was asked, then fill in the defaults."""
+    given = {k for k in _FLAG if getattr(args, k, None) is not None}
+    if args.recertify is not None:
+        bad = given
+        why = "--recertify re-checks a saved design file alone"
+    elif args.system is not None:
+        bad = given & {"delta_bar", "points", "gamma"}
+        why = "with --system the file states its own uncertainty (its [uncertainty] table) and design"
+    else:
+        bad = set()
+    if bad:
+        raise InputError(f"{', '.join(sorted(_FLAG[k] for k in bad))} does not apply here: {why}")
+    for key, value in _DESIGN_DEFAULTS.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
 
 
 def _cmd_design(args):
+    _check_design_options(args)
     if args.save is not None:  # before the heavy imports and the solver: an empty path, a folder, a missing folder
         check_new_file("--save", args.save, example="design.json")
     if args.recertify is not None or args.system is not None:
@@ -145,7 +170,7 @@ def _cmd_design(args):
     rep = design_report_from(result)
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
-    print(json.dumps(rep, indent=2) if args.json else format_design_report(rep))
+    print(dumps_strict(rep, indent=2) if args.json else format_design_report(rep))
 
 
 def _cmd_design_own(args):
@@ -157,7 +182,7 @@ def _cmd_design_own(args):
         if args.system is not None or args.save is not None:
             raise InputError("--recertify takes a design file alone (no --system, no --save)")
         rep = recertify(args.recertify)
-        print(json.dumps(rep, indent=2) if args.json else "\n".join(
+        print(dumps_strict(rep, indent=2) if args.json else "\n".join(
             [f"design file {rep['path']}: {'RECERTIFIED' if rep['ok'] else 'NOT RECERTIFIED'}",
              f"  stored gamma {rep['gamma']:.10g}; LMI witness re-evaluated in float64: {rep['lmi_gamma_recomputed']:.10g}",
              f"  worst sampled H-infinity norm {rep['sampled_worst_norm']:.10g} over {rep['n_samples']} samples",
@@ -173,7 +198,7 @@ def _cmd_design_own(args):
                                           objective=args.objective, solver=args.solver)
     if args.save:
         rep["saved_to"] = str(save_design(result, result.system, args.save, options={"system_file": args.system}))
-    print(json.dumps(rep, indent=2) if args.json else "\n".join(
+    print(dumps_strict(rep, indent=2) if args.json else "\n".join(
         [f"certified {'H2 bound' if rep['objective'] == 'h2' else 'gamma'} {rep['gamma']:.10g} (solver "
          f"{rep['lmi_gamma']:.10g}), worst sampled norm "
          f"{rep['verified_worst_norm']:.10g} over {rep['n_samples']} samples",
@@ -192,7 +217,7 @@ def _cmd_design_h2(args, save_design):
     rep, result = mixed_design_report(None, args.delta_bar, gamma=args.gamma, solver=args.solver, points=args.points)
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
-    print(json.dumps(rep, indent=2) if args.json else format_mixed_design_report(rep))
+    print(dumps_strict(rep, indent=2) if args.json else format_mixed_design_report(rep))
 
 
 def _cmd_reproduce(args):
@@ -234,12 +259,26 @@ def _limit(text):
     return name.strip(), int(number) if number.is_integer() else number
 
 
+class _VersionAction(argparse.Action):
+    """``--version``: the package version (computed only when asked: from git in a checkout)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .io.provenance import package_version
+
+        print(f"hinfnav {package_version()}")
+        parser.exit()
+
+
 def _parser():
     p = argparse.ArgumentParser(
         prog="python -m hinfnav",
         description="hinfnav: robust navigation filtering of spacecraft, reproduced and extended "
                     "(base: Sun et al. 2011, robust H-infinity filtering for a chaser satellite).",
     )
+    p.add_argument("--version", action=_VersionAction, help="print hinfnav's version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
@@ -260,21 +299,22 @@ def _parser():
     s.set_defaults(func=_cmd_simulate)
 
     d = sub.add_parser("design", help="design a robust H-infinity filter by LMI (Corollary 1) and certify it")
-    d.add_argument("--delta-bar", type=float, default=0.05, help="uncertainty bound delta_bar >= 0 (default 0.05)")
+    d.add_argument("--delta-bar", type=float, default=None, help="uncertainty bound delta_bar >= 0 of the built-in "
+                   "scenario (default 0.05; not with --system, whose file states its own)")
     _lazy(d.add_argument("--solver", default=None, type=str.upper,
                          help="SDP solver (default: CVXOPT, then CLARABEL if CVXOPT certifies nothing; SCS is slow and "
                               "loose, with a warning)"), SOLVER_CHOICES)
-    d.add_argument("--form", default="general", choices=("general", "observer"),
+    d.add_argument("--form", default=None, choices=("general", "observer"),
                    help="filter structure: general (the paper's LMI (20), default) or observer "
                         "(extension: error independent of the trajectory)")
     d.add_argument("--save", metavar="FILE", default=None,
                    help="write the certified filter, the system it was designed for and provenance to FILE (JSON)")
-    d.add_argument("--objective", default="hinf", choices=("hinf", "h2"),
+    d.add_argument("--objective", default=None, choices=("hinf", "h2"),
                    help="hinf: Corollary 1, min gamma (default); h2: mixed H2/H-infinity, min the certified H2 bound "
                         "subject to --gamma (without --gamma: the front gamma* .. 10 gamma* and its knee)")
     d.add_argument("--gamma", type=float, default=None,
                    help="with --objective h2: the H-infinity bound (above gamma* of Corollary 1)")
-    d.add_argument("--points", type=int, default=12, help="with --objective h2 and no --gamma: front points (default 12)")
+    d.add_argument("--points", type=int, default=None, help="with --objective h2 and no --gamma: front points (default 12)")
     d.add_argument("--system", metavar="SYS.toml", default=None,
                    help="design for your own system from a TOML file (dt, [nominal] A B C D L, optional "
                         "[uncertainty] norm-bounded H E or polytope vertices) instead of the built-in scenario")
@@ -324,7 +364,7 @@ def main(argv=None):
         parser.error(f"--runs must be >= 1; got {args.runs}")
     if getattr(args, "runs", None) is not None and args.runs > MAX_RUNS:
         parser.error(f"--runs must be at most {MAX_RUNS}; got {args.runs}")
-    if hasattr(args, "delta_bar") and not (math.isfinite(args.delta_bar) and args.delta_bar >= 0):
+    if getattr(args, "delta_bar", None) is not None and not (math.isfinite(args.delta_bar) and args.delta_bar >= 0):
         parser.error(f"--delta-bar must be a finite number >= 0; got {args.delta_bar}")
     if hasattr(args, "delta") and not math.isfinite(args.delta):
         parser.error(f"--delta must be finite; got {args.delta}")
@@ -341,6 +381,11 @@ def main(argv=None):
     except HinfnavError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2 if isinstance(exc, ValueError) else 1
+    except KeyboardInterrupt:
+        # one line, no traceback: the writers publish a folder or file only when complete (atomic), so an
+        # interrupted run leaves no partial output behind
+        print("interrupted (Ctrl-C): stopped; nothing half-written is left (a campaign keeps its finished cells: run it again to resume)", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         # output piped into e.g. `head`, which closed early: not an error of ours
         sys.stdout = open(os.devnull, "w")

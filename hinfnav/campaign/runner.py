@@ -38,6 +38,8 @@ import importlib
 import json
 import logging
 import os
+import signal
+import threading
 import time
 from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
@@ -230,8 +232,13 @@ def _clean(obj):
 
 def _atomic_write(path, text):
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except BaseException:  # a full disk or Ctrl-C: no temporary file left behind
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
 
 
 def _read_cell(path, cell_id):
@@ -244,14 +251,34 @@ def _read_cell(path, cell_id):
     return data
 
 
+def _main_thread():
+    return threading.current_thread() is threading.main_thread()
+
+
 def _open_client(client, workers, connect_timeout):
     """``(client, owned)``: the client to use and whether this call made it (and must close it)."""
     from distributed import Client, LocalCluster  # heavy optional library: imported when a campaign runs
 
     if client is None:
         n = workers if workers is not None else (os.cpu_count() or 1)
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               silence_logs=logging.ERROR)
+        try:
+            # the worker processes start with Ctrl-C ignored (an ignored signal stays ignored in a child): a Ctrl-C
+            # then reaches this process alone, which stops the campaign in one line and closes the cluster, instead
+            # of every worker printing its own traceback
+            previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            finally:
+                if previous is not None:
+                    signal.signal(signal.SIGINT, previous)
+        except KeyboardInterrupt:
+            raise
+        except Exception as exc:  # "Nanny failed to start" and the like: one line, the cause named
+            cause = exc.__cause__ or exc.__context__ or exc
+            raise HinfnavError(f"the local Dask cluster did not start ({n} worker processes): {type(exc).__name__}: "
+                               f"{exc} (cause: {type(cause).__name__}: {cause}); a worker killed or out of memory "
+                               "while starting? try again, or with fewer --workers") from None
         return Client(cluster), True
     if isinstance(client, str):
         try:

@@ -56,12 +56,12 @@ import json
 import math
 import numbers
 import os
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..core.tomlfile import read_toml
 from ..core.exceptions import InputError
 from ..estimators.registry import estimator_entry, fit_reason, registered_estimators
 from ..noise import NOISE_NAMES
@@ -258,6 +258,11 @@ class Campaign:
                 raise InputError(f"estimator_options.{key} must be a table of options; got {opts!r}")
             canonical(opts)
         set_("estimator_options", {str(k): dict(v) for k, v in self.estimator_options.items()})
+        in_grid = self.grid["estimator"]
+        stray = sorted(set(self.estimator_options) - set(registered_estimators() if "all" in in_grid else in_grid))
+        if stray:  # options for an estimator the grid does not run: a misspelt name, never silently ignored
+            raise InputError(f"estimator_options.{stray[0]}: {stray[0]!r} is not an estimator of the grid "
+                             f"({', '.join(map(str, in_grid))}); options apply only to estimators the grid runs")
         object.__setattr__(self, "_cells", None)
         object.__setattr__(self, "_sizes", ())
         object.__setattr__(self, "_tried", ())
@@ -477,13 +482,6 @@ def load_campaign(spec: Campaign | Mapping[str, Any] | str | os.PathLike[str]) -
         path = Path(spec).expanduser()
         if not path.is_file():
             raise InputError(f"spec: no campaign file at {path}")
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise InputError(f"spec: {path} is not valid TOML ({exc})") from None
-        except UnicodeDecodeError as exc:
-            raise InputError(f"spec: {path} is not UTF-8 text, as TOML requires (byte {exc.object[exc.start]:#04x} "
-                             f"at offset {exc.start}); save it as UTF-8 (it may be Latin-1 or Windows-1252)") from None
+        data = read_toml(path, "spec: campaign file")  # names a BOM, an encoding, invalid TOML, a key given twice
         return Campaign.from_dict(data, source=f"spec {path.name}")
     raise InputError(f"spec must be a Campaign, a dict or the path of a TOML file; got {type(spec).__name__}")

@@ -8,6 +8,8 @@ so a caller can catch all of them at once. Input errors also derive from
 __all__ = [
     "HinfnavError",
     "InputError",
+    "ModelFunctionError",
+    "FilterDivergedError",
     "UnstablePlantError",
     "SynthesisError",
     "InfeasibleLMIError",
@@ -26,6 +28,35 @@ class InputError(HinfnavError, ValueError):
     """A parameter has the wrong shape, type or value.
 
     The message names the parameter and says what is wrong with it.
+    """
+
+
+class ModelFunctionError(InputError):
+    """A user's model function (f, h, a Jacobian, a derivative) raised or returned something unusable.
+
+    The message names the model, the function and, when an estimator ran it,
+    the step (issue 36: a user model is checked at the door, never silently
+    broadcast). ``model``, ``function`` and ``step`` are kept as attributes.
+    """
+
+    def __init__(self, message, *, model=None, function=None, step=None):
+        super().__init__(message)
+        self.model, self.function, self.step, self.detail = model, function, step, message
+
+    def at_step(self, step):
+        """The same error, its message prefixed with the estimator step (once)."""
+        if self.step is not None:
+            return self
+        err = ModelFunctionError(f"at step {step}: {self.detail}", model=self.model, function=self.function, step=step)
+        err.__cause__ = self.__cause__
+        return err
+
+
+class FilterDivergedError(HinfnavError):
+    """A filter's estimate or covariance became non-finite (NaN or inf) (issue 36, never silent).
+
+    Raised at the step where it happened, identically by the NumPy and the
+    compiled paths; the message names the filter and the step.
     """
 
 

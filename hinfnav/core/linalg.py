@@ -58,7 +58,7 @@ def as_covariance(name, value, n, definite):
     scale = max(float(np.max(np.abs(M))), np.finfo(float).tiny)
     if not np.allclose(M, M.T, rtol=0, atol=1e-10 * scale):
         raise InputError(f"{name} must be symmetric (a covariance matrix)")
-    M = 0.5 * (M + M.T)
+    M = 0.5 * M + 0.5 * M.T  # halves first: no overflow near the largest double
     low = float(np.min(np.linalg.eigvalsh(M)))
     if definite and low <= 0:
         raise InputError(f"{name} must be positive definite; its smallest eigenvalue is {low:.3g}")

@@ -6,6 +6,7 @@ and what is wrong with it, before any numerical work starts.
 
 import numbers
 import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -145,4 +146,10 @@ def check_new_file(name, value, example="result.json"):
         raise InputError(f"{name} {path}: the folder {path.parent} does not exist")
     if not path.parent.is_dir():
         raise InputError(f"{name} {path}: {path.parent} is a file, not a folder")
+    try:  # a real probe before any work: a read-only folder or file system is named now, not after a solve
+        fd, probe = tempfile.mkstemp(dir=path.parent, prefix=".hinfnav-probe-")
+    except OSError as exc:
+        raise InputError(f"{name} {path}: cannot write in the folder {path.parent} ({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
     return path

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..io.outputs import atomic_write_text
 from ..io.provenance import provenance
 from ..core.validation import as_path, check_new_file
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
@@ -82,6 +83,19 @@ def content_fingerprint(d):
     return hashlib.sha256(json.dumps(body, sort_keys=True, allow_nan=True).encode()).hexdigest()
 
 
+def _same_system(a, b):
+    """True when two systems have the same kind, dt and matrices (bitwise: a certificate holds for those only)."""
+    if type(a) is not type(b) or float(a.dt) != float(b.dt):
+        return False
+    if isinstance(a, PolytopicSystem):
+        return a.n_vertices == b.n_vertices and all(
+            np.array_equal(getattr(u, k), getattr(v, k)) for u, v in zip(a.vertices, b.vertices) for k in MATRIX_KEYS)
+    keys = ("A", "B", "C", "D", "L", "H", "E")
+    return all((getattr(a, k, None) is None and getattr(b, k, None) is None)
+               or (getattr(a, k, None) is not None and getattr(b, k, None) is not None
+                   and np.array_equal(getattr(a, k), getattr(b, k))) for k in keys)
+
+
 def design_to_dict(result, system, *, options=None, extra=None):
     """JSON-ready dict of a certified design (:class:`SynthesisResult` or :class:`PolytopicResult`) and its system."""
     polytopic = isinstance(result, PolytopicResult)
@@ -91,6 +105,10 @@ def design_to_dict(result, system, *, options=None, extra=None):
     if not isinstance(system, want):
         raise InputError(f"system must be the {want.__name__} the filter was designed for; got {type(system).__name__}")
     dt = 1.0 if result.dt is True else float(result.dt)
+    designed_for = getattr(result, "system", None)
+    if designed_for is not None and designed_for is not system and not _same_system(designed_for, system):
+        raise InputError("system is not the system this filter was designed for (its matrices or dt differ): a "
+                         "design file pairs a filter with the system it was certified on; pass result.system")
     cert = {
         "gamma": result.gamma,
         "lmi_gamma": result.lmi_gamma,
@@ -222,10 +240,7 @@ def save_design(result: SynthesisResult | PolytopicResult, system: UncertainSyst
     """Write a design file (JSON); returns the path. The file is written whole or not at all."""
     path = check_design_path(path)
     text = json.dumps(design_to_dict(result, system, options=options, extra=extra), indent=2) + "\n"
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return atomic_write_text(path, text)  # whole or nothing; no temporary file left on a failure
 
 
 def load_design(path: str | os.PathLike[str]) -> tuple[SynthesisResult | PolytopicResult, UncertainSystem | PolytopicSystem,

@@ -23,7 +23,7 @@ from ..core.exceptions import InputError
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..systems.polytopic import PolytopicSystem
 from .io import load_design
-from .polytopic import PolytopicResult, certify_polytopic, sampled_norms
+from .polytopic import COVERS, PolytopicResult, certify_polytopic, sampled_norms
 from .samples import default_uncertainty_samples
 
 __all__ = ["recertify"]
@@ -60,6 +60,16 @@ def _lmi_levels(result, system):
     return out
 
 
+def _lyapunov_proven(witness):
+    """"common" when the witness holds one Lyapunov matrix for every vertex (equal to 1e-12), else "parameter-dependent"."""
+    Ps = [np.asarray(P, dtype=float) for P in witness.get("P", [])]
+    if not Ps:
+        return "common"
+    scale = max(float(np.max(np.abs(Ps[0]))), np.finfo(float).tiny)
+    same = all(P.shape == Ps[0].shape and np.allclose(P, Ps[0], rtol=0, atol=1e-12 * scale) for P in Ps[1:])
+    return "common" if same else "parameter-dependent"
+
+
 def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Re-check a saved design in float64 without a solver and report.
 
@@ -87,6 +97,11 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
         name = "extended H2 LMIs (E2)" if result.objective == "h2" else "extended BRL (E1)"
         levels = {f"{name} at every vertex": certify_polytopic(system, result.A_F, result.B_F, result.C_F,
                                                                result.witness, result.form)[0]}
+        proven = _lyapunov_proven(result.witness)
+        if result.lyapunov != proven:  # the label must be what the witness proves (issue 36)
+            reasons.append(f"the file says lyapunov = {result.lyapunov!r} but its witness holds "
+                           f"{'one Lyapunov matrix for every vertex' if proven == 'common' else 'a different Lyapunov matrix per vertex'}"
+                           f": it proves {proven!r} only (covers {COVERS[proven]})")
         alphas = result.alphas if np.size(result.alphas) else None
         norms, radii, _ = sampled_norms(system, result.A_F, result.B_F, result.C_F, result.form, alphas,
                                         result.objective, witness=result.witness)
@@ -118,7 +133,9 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
         "lmi_gamma_recomputed": float(best),
         "sampled_worst_norm": worst,
         "n_samples": int(np.size(norms)),
-        "covers": d["certificate"].get("covers", ""),
+        "covers": (COVERS[proven] if isinstance(result, PolytopicResult) and proven != result.lyapunov
+                   else d["certificate"].get("covers", "")),
+        "lyapunov_proven": proven if isinstance(result, PolytopicResult) else "common",
         "objective": getattr(result, "objective", "hinf"),
         "reasons": reasons,
     }

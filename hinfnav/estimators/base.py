@@ -46,7 +46,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.exceptions import InputError
+from ..core.exceptions import FilterDivergedError, InputError, ModelFunctionError
+from ..core.linalg import as_covariance
 from ..core.validation import as_choice, as_int_at_least, as_vector
 from .compiled import run_compiled, select_backend
 
@@ -56,7 +57,19 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "store_diagnostics", "MISSING", "PHASES", "available_channels", "initial_estimates"]
+           "store_diagnostics", "MISSING", "PHASES", "READING_LIMIT", "KNOWN_DIAGNOSTICS", "available_channels", "initial_estimates"]
+
+#: Largest |reading| a filter accepts: beyond it a squared innovation (an innovation moment, a Huber weight, a
+#: converted range) overflows double precision, and the NumPy and compiled paths would fail differently.
+READING_LIMIT = 1e150
+
+#: Every diagnostic name a hinfnav filter reports (collected over the registered estimators). A name asked of
+#: :meth:`Estimator.estimate` that is neither among these nor reported by the filter is refused (issue 36: a
+#: misspelt name is never ignored); a known name a filter does not report is left out, so one list can be asked
+#: of several filters (the consistency statistics ask every filter for the NIS inputs, a study for the weights).
+KNOWN_DIAGNOSTICS = ("converged", "existence_margin", "existence_ok", "fading", "fading_c", "innovation",
+                     "innovation_covariance", "input_estimate", "input_rate", "iterations", "q_adapted", "saturated",
+                     "theta", "theta_alg2", "weights")
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
@@ -213,6 +226,7 @@ def check_estimator_inputs(y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, 
     elif not np.all(np.isfinite(y)):
         raise InputError("y (the measurements) must contain only finite numbers; it has NaN or inf entries "
                          "(a filter built with missing='skip' skips NaN channels)")
+    _check_reading_size(y, "y (the measurements)")
     u = np.asarray(u, dtype=float)
     if u.ndim != 3 or u.shape[:2] != y.shape[:2]:
         raise InputError(f"u must have shape (runs, n_samples, n_input) matching y {y.shape[:2]}; got {u.shape}")
@@ -235,6 +249,12 @@ def initial_estimates(xhat0: ArrayLike, n_state: int, runs: int) -> NDArray[np.f
             raise InputError("xhat0 must contain only finite numbers; it has NaN or inf entries")
         return arr
     return as_vector("xhat0", xhat0, n_state)
+
+def _check_reading_size(y, what):
+    big = np.nanmax(np.abs(y), initial=0.0)
+    if big > READING_LIMIT:
+        raise InputError(f"{what} has an entry of magnitude {big:.3g}, beyond {READING_LIMIT:g}: its square overflows "
+                         "double precision inside a filter (check the units, or the reading is corrupt)")
 
 
 class Estimator:
@@ -260,6 +280,27 @@ class Estimator:
     name = "estimator"
     uses_input = False
     vectorized = True
+    #: the noise matrices checked whenever they are set again after construction (name → must be definite)
+    checked_covariances = {"Q": False, "R": True, "P0": True}
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        """Q, R and P0 set after construction are checked as the constructor checks them (issue 36).
+
+        A new value must be a finite symmetric matrix of the size the filter was built with, positive
+        semidefinite (Q) or definite (R, P0); a per-run or per-step stack (3-D) keeps its shape.
+        """
+        old = self.__dict__.get(name) if name in self.checked_covariances else None
+        if old is not None and value is not None:
+            old_arr = np.asarray(old)
+            if old_arr.ndim == 2:
+                value = as_covariance(f"{type(self).__name__}.{name}", value, old_arr.shape[0],
+                                      definite=self.checked_covariances[name])
+            else:
+                arr = np.asarray(value, dtype=float)
+                if arr.shape != old_arr.shape or not np.isfinite(arr).all():
+                    raise InputError(f"{type(self).__name__}.{name} must be a finite array of shape {old_arr.shape}; "
+                                     f"got shape {arr.shape}")
+        object.__setattr__(self, name, value)
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, name: str | None = None,
                  missing: str = "refuse") -> None:
@@ -347,7 +388,12 @@ class Estimator:
         elif not np.isfinite(y).all():
             raise InputError(f"filter {self.name!r}: y at step {k} must contain only finite numbers; it has NaN or "
                              "inf entries (build the filter with missing='skip' to skip NaN channels)")
-        new, out = self._update(state, y)
+        _check_reading_size(y, f"filter {self.name!r}: y at step {k}")
+        try:
+            new, out = self._update(state, y)
+        except ModelFunctionError as exc:
+            raise exc.at_step(k) from exc.__cause__
+        self._check_finite(out, k)
         return self._phase(new, state, "posterior"), out
 
     def predict(self, state: FilterState, u: ArrayLike | None = None) -> FilterState:
@@ -358,7 +404,11 @@ class Estimator:
         """
         self._check_order(state, "predict", "posterior")
         u = self._check_step_input(state, u, "predict")
-        return self._phase(self._predict(state, u), state, "prior")
+        try:
+            new = self._predict(state, u)
+        except ModelFunctionError as exc:
+            raise exc.at_step(state.k) from exc.__cause__
+        return self._phase(new, state, "prior")
 
     def step(self, state: FilterState, y: ArrayLike, u: ArrayLike | None = None) -> tuple[FilterState, StepOutput]:
         """``update`` with y_k, then ``predict`` with u_k; returns ``(state, StepOutput)``."""
@@ -417,6 +467,19 @@ class Estimator:
         """:meth:`predict` without its checks: ``u`` a finite float (runs, n_input) array, or None when the
         filter does not use its input (see :meth:`update_unchecked`)."""
         return self._predict(state, u)
+
+    def _check_finite(self, out, k):
+        """The non-finite policy: an estimate or covariance with NaN or inf raises :class:`FilterDivergedError`.
+
+        Every path does this at the step where it happens (the compiled one by handing a non-finite batch back
+        to this loop), so the NumPy and numba backends refuse the same inputs. A skipped reading leaves the
+        prior, which is finite; NaN marks nothing else in an estimate.
+        """
+        if not np.isfinite(out.xhat).all() or (out.P is not None and not np.isfinite(out.P).all()):
+            what = "estimate" if not np.isfinite(out.xhat).all() else "covariance"
+            raise FilterDivergedError(f"filter {self.name!r} diverged at step {k}: its {what} is not finite (NaN or "
+                                      "inf; readings or a model too large for double precision, or an unstable "
+                                      "filter)")
 
     @staticmethod
     def _phase(new, old, phase):
@@ -487,32 +550,45 @@ class Estimator:
                                  "'auto') with one initial estimate per run")
         elif select_backend(self, backend, keys) == "numba":
             xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
-            if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says
+            if xhat is not None and np.isfinite(xhat).all() and (P_hist is None or np.isfinite(P_hist).all()):
+                # else a factorisation failed or a number is not finite: the NumPy path raises at its step
                 return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks
         xhat = np.empty((runs, n1, self.n_state))
         P_hist, shared, diag = None, False, {}
-        for k in range(n1):
-            state, out = self._update(state, y[:, k])
-            xhat[:, k] = out.xhat
-            if keep_covariance and out.P is not None:
-                P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
-                if P_hist is None:
-                    # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
-                    shared = P.ndim == core or P.strides[0] == 0
-                    P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
-                if shared and not (P.ndim == core or P.strides[0] == 0):
-                    # a skipped channel in some runs only: the covariance becomes per run from here on
-                    P_hist, shared = np.broadcast_to(P_hist, (runs,) + P_hist.shape).copy(), False
-                if shared:
-                    P_hist[k] = P if P.ndim == core else P[0]
-                else:
-                    P_hist[:, k] = P
-            store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
-            if k < n1 - 1:
-                state = self._predict(state, u[:, k])
+        produced = set()
+        k = 0
+        try:
+            for k in range(n1):
+                state, out = self._update(state, y[:, k])
+                self._check_finite(out, k)
+                xhat[:, k] = out.xhat
+                if keep_covariance and out.P is not None:
+                    P = np.diagonal(out.P, axis1=-2, axis2=-1) if core == 1 else out.P
+                    if P_hist is None:
+                        # a covariance shared by every run (one array, or broadcast with stride 0) is stored once
+                        shared = P.ndim == core or P.strides[0] == 0
+                        P_hist = np.empty(((n1,) if shared else (runs, n1)) + P.shape[P.ndim - core:])
+                    if shared and not (P.ndim == core or P.strides[0] == 0):
+                        # a skipped channel in some runs only: the covariance becomes per run from here on
+                        P_hist, shared = np.broadcast_to(P_hist, (runs,) + P_hist.shape).copy(), False
+                    if shared:
+                        P_hist[k] = P if P.ndim == core else P[0]
+                    else:
+                        P_hist[:, k] = P
+                store_diagnostics(diag, out.diagnostics, keys, k, runs, n1)
+                if keys:
+                    produced.update(out.diagnostics)
+                if k < n1 - 1:
+                    state = self._predict(state, u[:, k])
+        except ModelFunctionError as exc:
+            raise exc.at_step(k) from exc.__cause__
+        unknown = keys - produced - set(KNOWN_DIAGNOSTICS) if keys else set()
+        if unknown:  # a name asked for that this filter never reports: refused, not ignored
+            raise InputError(f"unknown diagnostic {', '.join(map(repr, sorted(unknown)))} for filter "
+                             f"{self.name!r}; it reports: {', '.join(sorted(produced)) or 'none'}")
         if shared:
             P_hist.setflags(write=False)
             P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)

@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.exceptions import HinfnavError, InputError
+from ..core.exceptions import HinfnavError, InputError, ModelFunctionError
 from ..core.linalg import as_covariance, congruence
 from ..core.validation import as_choice
 from .adaptive import RateAdaptive, StrongTracking
@@ -205,6 +205,8 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
             # a missing channel reads as predicted (innovation 0; removed below)
             y, mask = fill_missing(self.measurement, y, x, yhat, mask)
             innovation = self.measurement.residual(y, yhat)
+        except ModelFunctionError:  # a user model's own error, already naming its function
+            raise
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
         R_k = self.measurement_covariance(y, x)

@@ -19,6 +19,8 @@ lists and builds every paper's estimators without this layer naming a paper.
 
 from __future__ import annotations
 
+import inspect
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
@@ -33,7 +35,11 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
-           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS"]
+           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS", "CORE_OPTIONS"]
+
+#: Options every estimator takes whatever its builder (issue 36): applied by :func:`build_estimator` to the built
+#: estimator through the :class:`~hinfnav.estimators.base.Estimator` contract (``missing``, its property).
+CORE_OPTIONS = ("missing",)
 
 #: State error forms: additive (x − x̂) or multiplicative quaternion (attitude).
 ERROR_FORMS = ("additive", "quaternion")
@@ -248,10 +254,30 @@ def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph"
         raise InputError(f"filter {name!r} does not fit this scenario ({type(scenario).__name__}: {why}); "
                          f"these do: {fitting}")
     gate = options.pop("gate", None)
-    est = entry.builder(scenario, **options)
+    core = {key: options.pop(key) for key in CORE_OPTIONS if key in options}
+    try:
+        est = entry.builder(scenario, **options)
+    except TypeError as exc:
+        bad = re.search(r"unexpected keyword argument '([^']+)'", str(exc))
+        if bad is None:
+            raise
+        raise InputError(f"filter {name!r} has no option {bad.group(1)!r}; its options: "
+                         f"{', '.join(_builder_options(entry.builder)) or 'none'} (and {', '.join(CORE_OPTIONS)}, "
+                         "which every filter takes)") from None
+    if "missing" in core:
+        est.missing = core["missing"]  # the contract's property checks the value and names it
     if gate is not None:  # a χ² innovation gate (hinfnav.estimators.gate)
         if not hasattr(type(est), "gate"):
             raise InputError(f"gate: filter {name!r} takes no gate (the Kalman core's filters and the sigma-point "
                              "filter do)")
         est.gate = gate  # a dict is the gate's parameters (the filter's setter builds it)
     return est if form == "joseph" else square_root(est)
+
+
+def _builder_options(builder):
+    """The keyword options a builder declares (its ``**options`` pass-through left out)."""
+    try:
+        params = list(inspect.signature(builder).parameters.values())[1:]
+    except (TypeError, ValueError):  # pragma: no cover - a builder without a signature
+        return []
+    return [p.name for p in params if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD)]

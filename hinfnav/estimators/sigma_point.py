@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core.exceptions import HinfnavError, InputError
+from ..core.exceptions import HinfnavError, InputError, ModelFunctionError
 from ..core.linalg import as_covariance, inv_spd
 from ..core.validation import as_choice, as_nonnegative, as_positive, as_real, as_vector
 from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
@@ -246,6 +246,8 @@ class SigmaPointFilter(GateOption, Estimator):
         try:
             Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
             ref = Y[:, 0] if self.rule == "unscented" else self.measurement.function(x)  # h(x̂⁻)
+        except ModelFunctionError:  # a user model's own error, already naming its function
+            raise
         except InputError as exc:
             raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: a sigma point reached a singular "
                                f"point of the measurement ({exc})") from None

@@ -18,6 +18,7 @@ import json
 import math
 import os
 import shutil
+import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
@@ -27,8 +28,8 @@ import numpy as np
 
 from ..core.exceptions import InputError
 
-__all__ = ["MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
-           "write_json"]
+__all__ = ["dumps_strict", "MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
+           "write_json", "check_writable_folder"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
 MARKER = ".hinfnav-output"
@@ -53,14 +54,28 @@ def check_output_dir(path: str | os.PathLike | None, name: str = "out") -> Path:
     probe = parent
     while not probe.exists():
         probe = probe.parent
-    if not os.access(probe, os.W_OK | os.X_OK):
-        raise InputError(f"{name} {target}: cannot write in {probe} (permission denied)")
+    check_writable_folder(probe, f"{name} {target}")
     if target.is_dir() and any(target.iterdir()) and not (target / MARKER).exists():
         raise InputError(
             f"{name} {target} already holds files that hinfnav did not write; refusing to replace it "
             "(choose an empty or new folder)"
         )
     return target
+
+
+def check_writable_folder(folder: str | os.PathLike, what: str) -> None:
+    """Raise an InputError naming the real cause unless a file can be created in ``folder`` now.
+
+    A real probe (a file created and removed), not :func:`os.access`: that says yes to root on a read-only
+    file system and cannot see a full disk's inode table or a mount that refuses writes.
+    """
+    try:
+        fd, probe = tempfile.mkstemp(dir=folder, prefix=".hinfnav-probe-")
+    except OSError as exc:
+        raise InputError(f"{what}: cannot write in {folder} ({exc.strerror or exc})") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
 
 
 def lock_path(target: str | os.PathLike) -> Path:
@@ -80,7 +95,11 @@ def output_lock(target: str | os.PathLike, name: str = "out") -> Iterator[None]:
     tries again, which ``filelock`` does), so a finished run leaves nothing beside its folder.
     """
     lock_file = lock_path(target)
-    lock_file.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        lock_file.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{name} {target}: cannot create the folder {lock_file.parent} ({exc.strerror or exc})") from None
+    check_writable_folder(lock_file.parent, f"{name} {target}")  # else filelock would wait and say "another process"
     lock = filelock.FileLock(lock_file, timeout=_LOCK_WAIT_S, is_singleton=False)
     try:
         lock.acquire()
@@ -158,13 +177,29 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
     """
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding=encoding, newline=newline)
-    os.replace(tmp, path)
+    try:
+        tmp.write_text(text, encoding=encoding, newline=newline)
+        os.replace(tmp, path)
+    except BaseException as exc:  # a full disk, a read-only folder, Ctrl-C: no temporary file left behind
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        if isinstance(exc, OSError):
+            raise OSError(exc.errno, f"cannot write {path}: {exc.strerror or exc}") from None
+        raise
     return path
 
 
-def write_json(path: str | os.PathLike, obj: Any, *, strict: bool = False) -> Any:
-    """Write ``to_json(obj, strict=strict)`` to ``path`` atomically (indented, newline at the end); return it."""
+def dumps_strict(obj: Any, **kwargs: Any) -> str:
+    """``json.dumps`` of ``to_json(obj, strict=True)``: strict JSON, NaN and infinities as null (issue 36)."""
+    return json.dumps(to_json(obj, strict=True), allow_nan=False, **kwargs)
+
+
+def write_json(path: str | os.PathLike, obj: Any, *, strict: bool = True) -> Any:
+    """Write ``to_json(obj, strict=strict)`` to ``path`` atomically (indented, newline at the end); return it.
+
+    Strict JSON by default (NaN and infinities as null, which every JSON reader accepts); ``strict=False``
+    keeps Python's ``NaN``/``Infinity`` tokens, for a reader that needs them.
+    """
     data = to_json(obj, strict=strict)
-    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
+    atomic_write_text(path, json.dumps(data, indent=2, allow_nan=not strict) + "\n")
     return data

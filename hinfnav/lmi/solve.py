@@ -22,6 +22,7 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
 from .conditioning import NORMALIZE_THRESHOLD
+from .forksafety import note_solve
 
 if TYPE_CHECKING:
     from .conditioning import Prepared
@@ -145,6 +146,7 @@ SCS_TIME_LIMIT_S = 20.0
 
 
 def solver_kwargs(solver, accuracy):
+    note_solve(solver)  # called before every solve: refuses a solve that would hang after fork (issue 36)
     if solver == "CLARABEL":
         return {"tol_gap_abs": accuracy, "tol_gap_rel": accuracy, "tol_feas": accuracy, "max_iter": 400}
     if solver == "CVXOPT":

@@ -30,6 +30,7 @@ Three ways to bring a model:
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -38,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
+from .checks import JACOBIAN_TOL, call_model, check_jacobian_against_differences, is_user_class
 from .state import StateSpec
 
 __all__ = [
@@ -48,7 +50,12 @@ __all__ = [
     "constant_turn_state_spec",
     "finite_difference_jacobian",
     "rk4_step",
+    "MAX_SUBSTEPS",
 ]
+
+#: Largest ``substeps`` a :class:`ContinuousDynamics` accepts: RK4's error falls as substeps⁻⁴, so beyond this a
+#: smooth model is integrated to rounding already, and a stiff one needs an implicit integrator, not hours of RK4.
+MAX_SUBSTEPS = 10_000
 
 
 def finite_difference_jacobian(fun, x, u=None, t=0.0):
@@ -138,6 +145,41 @@ class DynamicsModel:
     """
 
     linear = False
+    #: tolerance of the first-call check of a user Jacobian against central differences (None: no check)
+    jacobian_tol = JACOBIAN_TOL
+
+    def __init_subclass__(cls, **kwargs):
+        """A subclass written outside hinfnav has its ``f`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)."""
+        super().__init_subclass__(**kwargs)
+        if not is_user_class(cls):
+            return
+        if "f" in cls.__dict__:
+            cls.f = _checked_f(cls.__dict__["f"])
+        if "jacobian" in cls.__dict__:
+            cls.jacobian = _checked_jacobian(cls.__dict__["jacobian"])
+
+    @property
+    def _first_calls(self):
+        """Which first-call checks have run on this model (function name → True)."""
+        memo = self.__dict__.get("_first_call_memo")
+        if memo is None:
+            memo = self.__dict__["_first_call_memo"] = {}
+        return memo
+
+    @property
+    def _label(self):
+        return f"dynamics {getattr(self, 'name', type(self).__name__)!r}"
+
+    def _check_jacobian_once(self, J, x, u, t, jname, fun, fname):
+        """On the first call, ``J`` (runs, n, n) or (n, n) against central differences of ``fun`` at x[0]."""
+        key = "differences:" + jname
+        if self.jacobian_tol is None or self._first_calls.get(key):
+            return
+        u0 = None if u is None else u[:1]
+        fd = finite_difference_jacobian(fun, x[:1], u0, t)[0]
+        check_jacobian_against_differences(self._label, jname, J if J.ndim == 2 else J[0], fname, fd,
+                                           self.jacobian_tol, t)
+        self._first_calls[key] = True
 
     def __init__(self, state: StateSpec, dt: float, Q: ArrayLike, *, n_input: int = 0, name: str = "dynamics") -> None:
         if not isinstance(state, StateSpec):
@@ -219,13 +261,23 @@ class DiscreteDynamics(DynamicsModel):
     state, dt, Q, n_input, name
         As for :class:`DynamicsModel`.
     jacobian : callable, optional
-        ``jacobian(x, u, t)`` → (runs, n, n); default central differences.
+        ``jacobian(x, u, t)`` → (runs, n, n) (or (n, n), shared); default central differences.
+    jacobian_tol : float or None
+        Tolerance of the first-call comparison of ``jacobian`` with central
+        differences of ``fun`` (:mod:`hinfnav.systems.checks`); None: no check.
+
+    Notes
+    -----
+    ``fun`` and ``jacobian`` are checked at every call (shape, finiteness,
+    given a copy of x) and on the first call (batch convention, Jacobian
+    against differences): see :mod:`hinfnav.systems.checks`.
     """
 
     def __init__(self, fun: Callable[..., ArrayLike], state: StateSpec, dt: float, Q: ArrayLike, *,
                  jacobian: Callable[..., ArrayLike] | None = None, n_input: int = 0,
-                 name: str = "discrete dynamics") -> None:
+                 name: str = "discrete dynamics", jacobian_tol: float | None = JACOBIAN_TOL) -> None:
         super().__init__(state, dt, Q, n_input=n_input, name=name)
+        self.jacobian_tol = None if jacobian_tol is None else as_positive("jacobian_tol", jacobian_tol)
         if not callable(fun):
             raise InputError(f"fun must be callable as fun(x, u, t); got {type(fun).__name__}")
         if jacobian is not None and not callable(jacobian):
@@ -234,13 +286,17 @@ class DiscreteDynamics(DynamicsModel):
 
     def f(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         x, u, t = self.check(x, u, t)
-        return np.asarray(self._fun(x, u, t), dtype=float)
+        return call_model(self._label, "f(x, u, t)", self._fun, x, (u, t), out_tail=(self.n,), t=t,
+                          state=self._first_calls)
 
     def jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         if self._jac is None:
             return super().jacobian(x, u, t)
         x, u, t = self.check(x, u, t)
-        return np.broadcast_to(np.asarray(self._jac(x, u, t), dtype=float), (x.shape[0], self.n, self.n))
+        J = call_model(self._label, "jacobian(x, u, t)", self._jac, x, (u, t), out_tail=(self.n, self.n), t=t,
+                       allow_shared=True, state=self._first_calls)
+        self._check_jacobian_once(J, x, u, t, "jacobian(x, u, t)", self.f, "f")
+        return np.broadcast_to(J, (x.shape[0], self.n, self.n))
 
 
 class ContinuousDynamics(DynamicsModel):
@@ -256,18 +312,23 @@ class ContinuousDynamics(DynamicsModel):
     derivative_jacobian : callable, optional
         ``∂a/∂x`` (runs, n, n); default central differences of a.
     substeps : int
-        RK4 sub-steps per Δt (≥ 1).
+        RK4 sub-steps per Δt (1 to :data:`MAX_SUBSTEPS`).
+    jacobian_tol : float or None
+        Tolerance of the first-call comparison of ``derivative_jacobian`` with
+        central differences of ``derivative`` (None: no check).
 
     Notes
     -----
     :meth:`jacobian` is the exact Jacobian of the RK4 step (D2), product over
     the sub-steps: the covariance of an EKF follows the linearisation of the
-    discrete map that propagates its mean.
+    discrete map that propagates its mean. ``derivative`` and
+    ``derivative_jacobian`` are checked as :class:`DiscreteDynamics`' functions
+    (a (runs, 1) derivative is refused, not broadcast).
     """
 
     def __init__(self, derivative: Callable[..., ArrayLike], state: StateSpec, dt: float, Q: ArrayLike, *,
                  derivative_jacobian: Callable[..., ArrayLike] | None = None, substeps: int = 1, n_input: int = 0,
-                 name: str = "continuous dynamics") -> None:
+                 name: str = "continuous dynamics", jacobian_tol: float | None = JACOBIAN_TOL) -> None:
         super().__init__(state, dt, Q, n_input=n_input, name=name)
         if not callable(derivative):
             raise InputError(f"derivative must be callable as a(x, u, t); got {type(derivative).__name__}")
@@ -276,16 +337,27 @@ class ContinuousDynamics(DynamicsModel):
                              f"got {type(derivative_jacobian).__name__}")
         self._a, self._A = derivative, derivative_jacobian
         self.substeps = as_int_at_least("substeps", substeps, 1)
+        if self.substeps > MAX_SUBSTEPS:
+            raise InputError(f"substeps must be <= {MAX_SUBSTEPS}; got {self.substeps} (RK4's error falls as "
+                             "substeps⁻⁴: a smooth model is integrated to rounding well below this, and a stiff one "
+                             "needs an implicit integrator; the limit keeps a run from taking hours without a word)")
+        self.jacobian_tol = None if jacobian_tol is None else as_positive("jacobian_tol", jacobian_tol)
 
     def derivative(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
-        """ẋ = a(x, u, t), shape (runs, n)."""
-        return np.asarray(self._a(x, u, t), dtype=float)
+        """ẋ = a(x, u, t), shape (runs, n) (checked: :mod:`hinfnav.systems.checks`)."""
+        x = np.asarray(x, dtype=float)
+        return call_model(self._label, "derivative a(x, u, t)", self._a, x, (u, t), out_tail=(self.n,), t=t,
+                          state=self._first_calls)
 
     def derivative_jacobian(self, x: ArrayLike, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """∂a/∂x, shape (runs, n, n) (analytic if given, else central differences)."""
         if self._A is None:
             return finite_difference_jacobian(self.derivative, x, u, t)
-        return np.broadcast_to(np.asarray(self._A(x, u, t), dtype=float), (x.shape[0], self.n, self.n))
+        x = np.asarray(x, dtype=float)
+        J = call_model(self._label, "derivative_jacobian A(x, u, t)", self._A, x, (u, t), out_tail=(self.n, self.n),
+                       t=t, allow_shared=True, state=self._first_calls)
+        self._check_jacobian_once(J, x, u, t, "derivative_jacobian A(x, u, t)", self.derivative, "the derivative a")
+        return np.broadcast_to(J, (x.shape[0], self.n, self.n))
 
     def _integrate(self, x, u, t, with_jacobian):
         h = self.dt / self.substeps
@@ -400,3 +472,29 @@ class ConstantTurn(DynamicsModel):
         J[:, 2, 2], J[:, 2, 3], J[:, 2, 4] = cw, -sw, -T * (sw * vx + cw * vy)
         J[:, 3, 2], J[:, 3, 3], J[:, 3, 4] = sw, cw, T * (cw * vx - sw * vy)
         return J
+
+
+def _checked_f(raw):
+    """A user subclass's ``f`` called through :func:`~hinfnav.systems.checks.call_model`."""
+
+    @functools.wraps(raw)
+    def f(self, x, u=None, t=0.0):
+        x, u, t = self.check(x, u, t)
+        return call_model(self._label, "f(x, u, t)", functools.partial(raw, self), x, (u, t), out_tail=(self.n,),
+                          t=t, state=self._first_calls)
+
+    return f
+
+
+def _checked_jacobian(raw):
+    """A user subclass's ``jacobian``: checked, and compared with differences of f on its first call."""
+
+    @functools.wraps(raw)
+    def jacobian(self, x, u=None, t=0.0):
+        x, u, t = self.check(x, u, t)
+        J = call_model(self._label, "jacobian(x, u, t)", functools.partial(raw, self), x, (u, t),
+                       out_tail=(self.n, self.n), t=t, allow_shared=True, state=self._first_calls)
+        self._check_jacobian_once(J, x, u, t, "jacobian(x, u, t)", self.f, "f")
+        return np.broadcast_to(J, (x.shape[0], self.n, self.n))
+
+    return jacobian

@@ -25,14 +25,31 @@ Every error names the key in the file.
 from __future__ import annotations
 
 import os
-import tomllib
 
 from ..core.exceptions import InputError
-from ..core.validation import as_matrix, as_path, as_positive
+from ..core.tomlfile import check_schema, read_toml
+from ..core.validation import as_matrix, as_positive
 from .polytopic import MATRIX_KEYS, PolytopicSystem
 from .uncertain import UncertainSystem
 
-__all__ = ["read_system_file"]
+__all__ = ["read_system_file", "SYSTEM_SCHEMA", "UNCERTAINTY_KEYS"]
+
+#: Every key a system file may hold, with its kind (:func:`hinfnav.core.tomlfile.check_schema`); any other key, at
+#: any level, is refused naming it. A new key is one line here (and its use in :func:`read_system_file`).
+SYSTEM_SCHEMA = {
+    "dt": "number",
+    "nominal": {key: "matrix" for key in MATRIX_KEYS},
+    "uncertainty": {
+        "kind": "string",
+        "H": "matrix",
+        "E": "matrix",
+        "vertices": [{key: "matrix" for key in MATRIX_KEYS}],
+        "cells": "any",  # checked by read_system_file: groups of vertex indices: the family is the union of their hulls
+    },
+}
+
+#: The keys of [uncertainty] each kind uses (the others do not apply to it and are refused).
+UNCERTAINTY_KEYS = {"norm-bounded": ("kind", "H", "E"), "polytope": ("kind", "vertices", "cells")}
 
 
 def _matrix(where, table, key, required=True):
@@ -59,23 +76,12 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
     InputError
         Missing file, not UTF-8, not TOML, a missing or malformed key (named).
     """
-    path = as_path("path", path)
-    if not path.is_file():
-        raise InputError(f"system file {path} does not exist (or is not a file)")
-    raw = path.read_bytes()
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"system file {path} is not UTF-8 text (byte {exc.start}); TOML files must be UTF-8 "
-                         "(re-save it as UTF-8)") from None
-    try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"system file {path} is not valid TOML ({exc})") from None
+    d = read_toml(path, "system file")
     where = str(path)
-    unknown = sorted(set(d) - {"dt", "nominal", "uncertainty"})
-    if unknown:
-        raise InputError(f"{where}: unknown top-level key(s) {unknown}; allowed: dt, [nominal], [uncertainty]")
+    try:
+        check_schema(d, SYSTEM_SCHEMA)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
     if "dt" not in d:
         raise InputError(f"{where}: missing key 'dt' (the sampling time, s)")
     try:
@@ -96,6 +102,10 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
         if not isinstance(unc, dict):
             raise InputError("key 'uncertainty' must be a table [uncertainty]")
         kind = unc.get("kind")
+        stray = sorted(set(unc) - set(UNCERTAINTY_KEYS.get(kind, unc)))
+        if stray:
+            raise InputError(f"[uncertainty] key(s) {stray} do not apply to kind = {kind!r} (it uses "
+                             f"{', '.join(UNCERTAINTY_KEYS[kind])})")
         if kind == "norm-bounded":
             H, E = _matrix("[uncertainty]", unc, "H"), _matrix("[uncertainty]", unc, "E")
             return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], H, E, dt=dt)
@@ -110,6 +120,10 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
                     raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
                                      f"{', '.join(MATRIX_KEYS)}")
             verts = [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
+            try:  # [nominal] must be a system on its own, even where every vertex replaces one of its matrices
+                UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=dt)
+            except InputError as exc:
+                raise InputError(f"[nominal]: {exc}") from None
             poly = PolytopicSystem.from_matrices(mats, verts, dt)
             cells = unc.get("cells")  # optional: groups of vertex indices; the family is the union of their hulls
             if cells is None:

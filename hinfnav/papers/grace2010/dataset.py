@@ -28,6 +28,7 @@ with ``M`` the rows x̂, ŷ, ẑ: the velocity of the deputy (GRACE-A) seen in t
 """
 
 import gzip
+import zlib
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
@@ -55,20 +56,30 @@ def _data_path(name):
     return resources.files(__package__).joinpath("data", name)
 
 
-def _seconds(dates, times):
-    """Seconds since 2010-07-27 00:00:00 from ``d/m/yyyy`` and ``hh:mm:ss`` strings."""
-    out = np.empty(len(dates))
-    day0 = np.datetime64("2010-07-27")
-    for i, (d, t) in enumerate(zip(dates, times)):
+def _line_seconds(source, lineno, d, t):
+    """Seconds since 2010-07-27 00:00:00 of one line's ``d/m/yyyy`` and ``hh:mm:ss`` fields (errors name the line)."""
+    try:
         dd, mm, yy = (int(v) for v in d.split("/"))
         h, mi, s = (float(v) for v in t.split(":"))
         day = np.datetime64(f"{yy:04d}-{mm:02d}-{dd:02d}")
-        out[i] = (day - day0).astype("timedelta64[D]").astype(float) * 86400.0 + 3600.0 * h + 60.0 * mi + s
-    return out
+        if not (0 <= h < 24 and 0 <= mi < 60 and 0 <= s < 61):
+            raise ValueError("time of day out of range")
+    except ValueError as exc:
+        raise InputError(f"{source}: line {lineno}: date {d!r} and time {t!r} are not d/m/yyyy and hh:mm:ss "
+                         f"({exc})") from None
+    return (day - _DAY0).astype("timedelta64[D]").astype(float) * 86400.0 + 3600.0 * h + 60.0 * mi + s
+
+
+_DAY0 = np.datetime64("2010-07-27")
 
 
 def _rows(source, n_numbers):
-    """Date and time strings and the numbers of a CSV file (gzip when its name ends in .gz)."""
+    """Date and time strings and the numbers of a CSV file (gzip when its name ends in .gz).
+
+    Every error names the file and, for its content, the line (issue 36): a file that cannot be read, a
+    gzip file that is truncated or is not gzip, text that is not ASCII, a line with the wrong number of
+    fields, a bad date or number, NaN or inf, time not increasing, no data at all.
+    """
     try:
         if hasattr(source, "read_bytes"):
             raw = source.read_bytes()
@@ -77,18 +88,40 @@ def _rows(source, n_numbers):
                 raw = fh.read()
     except (OSError, TypeError) as exc:
         raise InputError(f"source must be a readable file; {source!r}: {exc}") from None
-    text = (gzip.decompress(raw) if str(source).endswith(".gz") else raw).decode("ascii")
-    dates, times, nums = [], [], []
+    if str(source).endswith(".gz"):
+        try:
+            raw = gzip.decompress(raw)
+        except (OSError, EOFError, zlib.error) as exc:
+            raise InputError(f"{source}: not a complete gzip file ({type(exc).__name__}: {exc or 'truncated'}); "
+                             "download or copy it again") from None
+    try:
+        text = raw.decode("ascii")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise InputError(f"{source}: line {line}: byte {raw[exc.start]:#04x} is not ASCII (these files are plain "
+                         "ASCII CSV: date, time, numbers)") from None
+    t, nums = [], []
     for i, line in enumerate(text.splitlines()):
         if not line.strip():
             continue
         parts = line.split(",")
         if len(parts) != 2 + n_numbers:
             raise InputError(f"{source}: line {i + 1} has {len(parts)} fields; expected {2 + n_numbers}")
-        dates.append(parts[0])
-        times.append(parts[1])
-        nums.append([float(p) for p in parts[2:]])
-    return _seconds(dates, times), np.asarray(nums)
+        try:
+            row = [float(p) for p in parts[2:]]
+        except ValueError as exc:
+            raise InputError(f"{source}: line {i + 1}: {exc}") from None
+        if not all(np.isfinite(row)):
+            raise InputError(f"{source}: line {i + 1} has NaN or inf among its numbers; the files hold measured "
+                             "values only")
+        ti = _line_seconds(source, i + 1, parts[0].strip(), parts[1].strip())
+        if t and ti <= t[-1]:
+            raise InputError(f"{source}: line {i + 1}: time {parts[0]} {parts[1]} is not after the previous line's")
+        t.append(ti)
+        nums.append(row)
+    if not nums:
+        raise InputError(f"{source}: no data lines (the file is empty)")
+    return np.asarray(t), np.asarray(nums)
 
 
 def read_orbit_file(source):
