@@ -49,16 +49,16 @@ NAMES = registered_estimators()
 
 #: The registered estimators that have a kernel on their scenario (a kernel lost by a refactoring fails here).
 WITH_KERNEL = {"ekf", "ekf_known_input", "recursive_hinf", "ekf_augmented_thrust", "ekf_augmented_thrust_st", "hbf",
-               "ukf", "stekf", "model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_hinf"}
+               "ukf", "stekf", "model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_hinf", "huber_stekf"}
 #: ... and those that fall back: the LTI filters (already one vectorised recursion), the attitude filters
 #: (quaternion states), the rate-adaptive filter (data-dependent Q), the converted measurement (R from the
-#: reading), Yang 2020's extended-state filters (their own hooks), Huber x strong tracking on the EKF core (no kernel
-#: class yet), the benchmark's rate-adapted random-walk filter (data-dependent Q) and its LMI observer (an LTI filter).
+#: reading), Yang 2020's extended-state filters (their own hooks), the benchmark's rate-adapted random-walk filter
+#: (data-dependent Q) and its LMI observer (an LTI filter).
 #: The benchmark's other generic filters are built on Sun's chaser, whose declared Kalman model they fit first.
 WITHOUT_KERNEL = {"published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                   "designed_observer_closed_loop", "aekf", "astekf", "aaekf", "ekf_augmented_thrust_adaptive",
                   "ekf_converted", "yang2020_alg1", "yang2020_alg2", "yang2020_alg2_ideal", "yang2020_alg2_skip",
-                  "yang2020_fused", "attitude_hbf", "attitude_ukf", "huber_stekf", "model_adaptive", "model_lmi"}
+                  "yang2020_fused", "attitude_hbf", "attitude_ukf", "model_adaptive", "model_lmi"}
 
 
 def _scenario(name):
@@ -168,6 +168,45 @@ def test_backend_options_checked(chaser_truth):
     est.missing = "skip"
     assert "missing='skip'" in kernel_status(est)
     assert select_backend(est, "auto") == "numpy"
+
+
+def test_auto_is_the_default_and_says_why_it_falls_back(chaser_truth, monkeypatch, caplog):
+    # the default of estimate is "auto": the kernel's numbers (bitwise those of backend="numba")
+    y, u = chaser_truth
+    est = _built("stekf", on_sun=True)
+    np.testing.assert_array_equal(est.estimate(y, u, SUN.xhat0).xhat,
+                                  est.estimate(y, u, SUN.xhat0, backend="numba").xhat)
+    assert compiled.why_numpy(est) is None
+    assert "diagnostics" in compiled.why_numpy(est, True)
+    with caplog.at_level("INFO", logger="hinfnav.backend"):  # the fallback is reported when asked (logging)
+        est.estimate(y[:, :5], u[:, :5], SUN.xhat0, diagnostics=True)
+    assert "NumPy path: diagnostics" in caplog.text
+    # HINFNAV_BACKEND (the CLI's --backend) and use_backend set the default of every estimate
+    monkeypatch.setenv(compiled.BACKEND_VARIABLE, "numpy")
+    assert select_backend(est, None) == "numpy"
+    with compiled.use_backend("numba"):
+        assert select_backend(est, None) == "numba"
+    assert select_backend(est, None) == "numpy"
+    monkeypatch.setenv(compiled.BACKEND_VARIABLE, "fortran")
+    with pytest.raises(hn.InputError, match="HINFNAV_BACKEND"):
+        select_backend(est, None)
+
+
+def test_kernels_are_declared_by_the_class_itself():
+    # a subclass that changes a hook does not inherit its base's kernel; declaring compiled_kernel restores it
+    from hinfnav.estimators import ExtendedKalmanFilter
+
+    base = _built("ekf", on_sun=True)
+
+    class Mine(ExtendedKalmanFilter):
+        pass
+
+    class MineDeclared(ExtendedKalmanFilter):
+        compiled_kernel = "kalman"
+
+    mine = Mine(base.system, base.measurement, P0=base.P0, Q=base.Q, R=base.R)
+    assert "its base class declares the 'kalman' kernel" in kernel_status(mine)
+    assert kernel_status(MineDeclared(base.system, base.measurement, P0=base.P0, Q=base.Q, R=base.R)) is None
 
 
 def test_numba_not_imported_without_the_backend():

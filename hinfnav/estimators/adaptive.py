@@ -196,6 +196,8 @@ class StrongTracking:
 
     data_dependent_covariance = True
     defers_prior = True
+    #: The prior is faded by (S1)-(S4) (read by the compiled kernels).
+    strong_tracking = True
 
     def __init__(self, *args: Any, rho: float = 0.95, beta: float = 1.0, a: ArrayLike | None = None,
                  **kwargs: Any) -> None:

@@ -247,6 +247,9 @@ class Estimator:
     name = "estimator"
     uses_input = False
     vectorized = True
+    #: The compiled kernel a class declares in its own body (one of
+    #: :data:`hinfnav.estimators.compiled.KERNELS`), None: the NumPy path only.
+    compiled_kernel = None
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, name: str | None = None,
                  missing: str = "refuse") -> None:
@@ -410,7 +413,7 @@ class Estimator:
 
     def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
                  keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False,
-                 backend: str = "numpy") -> EstimateHistory:
+                 backend: str | None = None) -> EstimateHistory:
         """Estimate the state histories of a batch of runs.
 
         Parameters
@@ -430,9 +433,12 @@ class Estimator:
         diagnostics : bool or iterable of str
             Return the diagnostics histories: all (True), none (False), or
             those named.
-        backend : {"numpy", "numba", "auto"}
-            The NumPy step loop (the reference), a compiled kernel, or the
-            kernel where one exists (see :mod:`hinfnav.estimators.compiled`).
+        backend : {"auto", "numpy", "numba"}, optional
+            The kernel where one exists (the default, unless the environment
+            variable ``HINFNAV_BACKEND`` says otherwise), the NumPy step loop
+            (the reference), or a compiled kernel (an InputError if none
+            fits); see :mod:`hinfnav.estimators.compiled` and its
+            :func:`~hinfnav.estimators.compiled.why_numpy`.
 
         Returns
         -------

@@ -2,15 +2,27 @@
 
 ``est.estimate(y, u, xhat0, P0, backend=...)`` chooses how the batch runs:
 
-* ``"numpy"`` (the default): the NumPy step loop, the reference of every
-  number the workbook reports;
+* ``"auto"`` (the default, or the environment variable ``HINFNAV_BACKEND``
+  when it is set: :func:`default_backend`): the kernel where one exists, the
+  NumPy path otherwise; :func:`why_numpy` says why a filter falls back (and
+  the ``hinfnav.backend`` logger reports it at INFO level);
+* ``"numpy"``: the NumPy step loop, the reference of every number the
+  workbook reports;
 * ``"numba"``: a compiled kernel (:mod:`hinfnav.estimators.compiled_kernels`)
   that runs every run over every step in one call. It exists for the filters
-  listed by :func:`kernel_status` on a linear system with a constant
-  measurement matrix (``y = H x + D v``), a constant R, ``missing="refuse"``
-  and no diagnostics requested; for any other estimator or option the request
-  raises an :class:`~hinfnav.core.exceptions.InputError` that says why;
-* ``"auto"``: the kernel where one exists, the NumPy path otherwise.
+  that declare one (the class attribute ``compiled_kernel``, one of
+  :data:`KERNELS`, set in the class's own body: a subclass that changes a hook
+  does not inherit it) on a linear system with a constant measurement matrix
+  (``y = H x + D v``), a constant R, ``missing="refuse"`` and no diagnostics
+  requested; for any other estimator or option the request raises an
+  :class:`~hinfnav.core.exceptions.InputError` that says why.
+
+A filter that declares a kernel gives it what it needs through public
+attributes: the model (``F``/``Gamma``/``Q``/``R`` or the augmented ``Phi_a``,
+``Qd``, ``H_augmented``), strong tracking's ``rho``/``beta``/``a`` (the
+mixin's ``strong_tracking`` flag), Huber's ``gamma``/``tol``/``max_iter``
+and ``whitening_matrix`` (the mixin's ``huber_correction`` flag), the
+recursive H∞ filter's ``G_theta`` and ``HtRi``.
 
 The kernels give the NumPy path's estimates and covariances to 1e-10 relative
 (``tests/test_compiled.py`` checks every registered estimator); the
@@ -36,8 +48,12 @@ load).
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
+import logging
+import os
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -47,22 +63,20 @@ from ..core.validation import as_choice
 from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
 
-__all__ = ["BACKENDS", "KERNEL_CLASSES", "kernel_status", "numba_available", "run_compiled", "select_backend"]
+__all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
+           "run_compiled", "select_backend", "use_backend", "why_numpy"]
 
 #: What ``Estimator.estimate(backend=...)`` accepts.
 BACKENDS = ("numpy", "numba", "auto")
 
-#: The estimator classes (of :mod:`hinfnav.estimators`, exactly: a subclass may change a hook) that have a kernel.
-KERNEL_CLASSES = {
-    "ExtendedKalmanFilter": "kalman",
-    "StrongTrackingEKF": "kalman",
-    "HuberFilter": "kalman",
-    "AugmentedInputKF": "augmented",
-    "AugmentedInputSTKF": "augmented",
-    "AugmentedInputHuberSTKF": "augmented",
-    "SigmaPointFilter": "sigma_point",
-    "RecursiveHInfinityFilter": "recursive_hinf",
-}
+#: The kernels a filter class may declare (its ``compiled_kernel`` attribute).
+KERNELS = ("kalman", "augmented", "sigma_point", "recursive_hinf")
+
+#: The environment variable that sets the backend of every ``estimate`` not given one (``python -m hinfnav
+#: ... --backend`` sets it, so that worker processes inherit it).
+BACKEND_VARIABLE = "HINFNAV_BACKEND"
+
+_LOG = logging.getLogger("hinfnav.backend")
 
 _KERNELS = {}
 
@@ -85,15 +99,37 @@ def _kernels():
     return _KERNELS["module"]
 
 
+def default_backend() -> str:
+    """The backend of an ``estimate`` called without one: ``$HINFNAV_BACKEND`` if set, else "auto"."""
+    return as_choice(BACKEND_VARIABLE, os.environ.get(BACKEND_VARIABLE, "auto"), BACKENDS)
+
+
+@contextlib.contextmanager
+def use_backend(backend: str | None) -> Iterator[None]:
+    """Within the block, every ``estimate`` called without a backend uses ``backend`` (None: leave it as it is).
+
+    Sets :data:`BACKEND_VARIABLE` in the environment (so that worker processes
+    started within the block inherit it) and restores it after.
+    """
+    if backend is None:
+        yield
+        return
+    backend = as_choice("backend", backend, BACKENDS)
+    old = os.environ.get(BACKEND_VARIABLE)
+    os.environ[BACKEND_VARIABLE] = backend
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(BACKEND_VARIABLE, None)
+        else:
+            os.environ[BACKEND_VARIABLE] = old
+
+
 def _kind(est):
-    cls = type(est)
-    if not cls.__module__.startswith(f"{__package__}.") or cls.__name__ not in KERNEL_CLASSES:
-        return None
-    return KERNEL_CLASSES[cls.__name__]
-
-
-def _mro_names(est):
-    return {c.__name__ for c in type(est).__mro__}
+    """The kernel declared by the estimator's own class (``compiled_kernel`` in its body), or None."""
+    kind = vars(type(est)).get("compiled_kernel")
+    return kind if kind in KERNELS else None
 
 
 def _linear_measurement(est):
@@ -111,8 +147,10 @@ def kernel_status(est: Any) -> str | None:
     """Why ``est`` has no compiled kernel, or None when it has one (diagnostics aside)."""
     kind = _kind(est)
     if kind is None:
-        return (f"no kernel for {type(est).__name__} (kernels: {', '.join(sorted(KERNEL_CLASSES))}, exactly these "
-                "classes of hinfnav.estimators)")
+        inherited = getattr(type(est), "compiled_kernel", None)
+        return (f"no kernel for {type(est).__name__}" + (
+            f" (its base class declares the {inherited!r} kernel; a subclass that changes a hook declares "
+            "compiled_kernel itself to keep it)" if inherited else " (the class declares no compiled_kernel)"))
     if est.missing != "refuse":
         return "missing='skip' runs on the NumPy path only"
     system = est.system
@@ -130,24 +168,41 @@ def kernel_status(est: Any) -> str | None:
     return None
 
 
-def select_backend(est: Any, backend: str, diagnostics: set | None = frozenset()) -> str:
-    """The backend that runs ``est.estimate``: "numpy" or "numba" (see the module docstring).
+def why_numpy(est: Any, diagnostics: set | bool | None = frozenset()) -> str | None:
+    """Why ``backend="auto"`` runs ``est`` on the NumPy path, or None when it runs its kernel.
 
-    ``diagnostics`` is what :func:`hinfnav.estimators.base.history_keys` returns
-    (None: all). Raises InputError naming ``backend`` when "numba" is asked for
-    and no kernel fits.
+    ``diagnostics`` as :meth:`~hinfnav.estimators.base.Estimator.estimate`
+    takes it (True/False or names) or as
+    :func:`~hinfnav.estimators.base.history_keys` returns it (a set; None: all).
     """
-    backend = as_choice("backend", backend, BACKENDS)
-    if backend == "numpy":
-        return "numpy"
+    if diagnostics is True:
+        diagnostics = None
+    elif diagnostics is False:
+        diagnostics = frozenset()
     reason = kernel_status(est)
     if reason is None and (diagnostics is None or diagnostics):
         reason = "diagnostics are computed on the NumPy path only (pass diagnostics=False)"
     if reason is None and not numba_available():
         reason = "numba is not installed (pip install numba==0.68.1)"
+    return reason
+
+
+def select_backend(est: Any, backend: str | None, diagnostics: set | None = frozenset()) -> str:
+    """The backend that runs ``est.estimate``: "numpy" or "numba" (see the module docstring).
+
+    ``backend`` None: :func:`default_backend`. ``diagnostics`` is what
+    :func:`hinfnav.estimators.base.history_keys` returns (None: all). Raises
+    InputError naming ``backend`` when "numba" is asked for and no kernel fits.
+    """
+    backend = default_backend() if backend is None else as_choice("backend", backend, BACKENDS)
+    if backend == "numpy":
+        return "numpy"
+    reason = why_numpy(est, diagnostics)
     if reason is None:
         return "numba"
     if backend == "auto":
+        if _LOG.isEnabledFor(logging.INFO):
+            _LOG.info("filter %r runs on the NumPy path: %s", getattr(est, "name", "?"), reason)
         return "numpy"
     raise InputError(f"backend='numba' is not available for filter {est.name!r}: {reason}; use backend='numpy' "
                      "or 'auto'")
@@ -185,15 +240,14 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     H = _float(est.measurement.H)
     shared = False
     if kind in ("kalman", "augmented"):
-        names = _mro_names(est)
-        strong, huber = "StrongTracking" in names, "HuberCorrection" in names
+        strong, huber = bool(getattr(est, "strong_tracking", False)), bool(getattr(est, "huber_correction", False))
         shared = bool(est.shares_covariance)
         if kind == "kalman":
             F, Qd, n_rep = est.F, est.Q, est.n_state
             G = est.Gamma if use_input else np.zeros((est.n_state, u.shape[2]))
         else:
             F, Qd, n_rep, use_input = est.Phi_a, est.Qd, est.n_state, False
-            H = _float(est._H)
+            H = _float(est.H_augmented)
             G = np.zeros((F.shape[0], u.shape[2]))
         n = F.shape[0]
     elif kind == "sigma_point":
@@ -210,7 +264,7 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     Pfull = np.empty((p_runs, steps, n_rep, n_rep)) if keep == 2 else np.empty((1, 1, 1, 1))
     F, G = _float(F), _float(G)
     if kind in ("kalman", "augmented"):
-        LRi = _float(est._LRi) if huber else np.eye(H.shape[0])
+        LRi = _float(est.whitening_matrix) if huber else np.eye(H.shape[0])
         rho = _per_run(est.rho, runs) if strong else np.ones(runs)
         beta = _per_run(est.beta, runs) if strong else np.ones(runs)
         a = _float(est.a) if strong else np.ones(n)
@@ -224,7 +278,7 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
                                     est.output == "filtered", _float(est.Wm), _float(est.Wc), float(est.scale),
                                     est.rule == "unscented", keep, xhat, Pdiag, Pfull)
     else:
-        ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est._G), _float(est._HtRi), P_start, x0, y, u,
+        ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est.G_theta), _float(est.HtRi), P_start, x0, y, u,
                                        use_input, _kernel_steady_tol(est), keep, xhat, Pdiag, Pfull)
     if not ok:
         return None, None
