@@ -32,6 +32,7 @@ from hinfnav.estimators import (AugmentedInputHuberSTKF, RecursiveHInfinityFilte
                                 registered_estimators)
 from hinfnav.estimators import compiled
 from hinfnav.estimators.compiled import kernel_status, select_backend
+from hinfnav.metrics import NIS_KEYS
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
 from hinfnav.papers.attitude2018.chaser import P0_THRUST_STD, Q_THRUST_BASE
 from hinfnav.papers.shi2018 import Scenario as ShiScenario
@@ -115,24 +116,32 @@ def test_numba_equals_numpy(chaser_truth):
     assert y.shape[0] > lanes and y.shape[0] % lanes  # both the blocked and the one-run loops run
     for name in sorted(WITH_KERNEL):
         est = _built(name, on_sun=True)
-        ref = est.estimate(y, u, SUN.xhat0)
-        _assert_same(ref, est.estimate(y, u, SUN.xhat0, backend="numba"), name)
-        assert select_backend(est, "auto") == "numba"
+        ref = est.estimate(y, u, SUN.xhat0, backend="numpy", diagnostics=NIS_KEYS)
+        got = est.estimate(y, u, SUN.xhat0, backend="numba", diagnostics=NIS_KEYS)
+        _assert_same(ref, got, name)
+        assert select_backend(est, "auto", set(NIS_KEYS)) == "numba"
+        # the NIS inputs (innovation and S), from the kernel's histories: those of the NumPy path
+        assert set(got.diagnostics) == set(ref.diagnostics) & set(NIS_KEYS), name
+        for key in got.diagnostics:
+            r, g = ref.diagnostics[key], got.diagnostics[key]
+            assert g.shape == r.shape, (name, key)
+            err = float(np.max(np.abs(g - r)) / np.abs(r).max())
+            assert err <= 1e-10, f"{name} {key}: differs by {err:.1e}"
     # the sigma-point kernel computes the points' deviations about zero, once for all runs: other weights too
     # (the cubature rule; alpha = 0.5, a negative centre weight), the same NumPy reference to 1e-10
     for options in ({"rule": "cubature"}, {"alpha": 0.5, "kappa": 1.0}):
         est = SigmaPointFilter.from_ekf(_built("ekf_known_input", on_sun=True), **options)
-        _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), str(options))
+        _assert_same(est.estimate(y, u, SUN.xhat0, backend="numpy"), est.estimate(y, u, SUN.xhat0, backend="numba"), str(options))
     # Huber x strong tracking on the augmented model (no registered name on the chaser): fading, then Huber's correction
     st = _built("ekf_augmented_thrust_st", on_sun=True)
     est = AugmentedInputHuberSTKF(st.system, st.measurement, Q_input=Q_THRUST_BASE * np.eye(3),
                                   P0=np.diag(DEFAULT_P0_STD**2), P0_input=np.eye(3) * P0_THRUST_STD**2, rho=0.95, beta=1.0)
     assert kernel_status(est) is None
-    _assert_same(est.estimate(y, u, SUN.xhat0), est.estimate(y, u, SUN.xhat0, backend="numba"), "huber x st")
+    _assert_same(est.estimate(y, u, SUN.xhat0, backend="numpy"), est.estimate(y, u, SUN.xhat0, backend="numba"), "huber x st")
     for keep in (False, "diagonal"):  # the covariance kept as asked
         for name in ("hbf", "ekf", "recursive_hinf", "ukf"):
             est = _built(name, on_sun=True)
-            ref = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep)
+            ref = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep, backend="numpy")
             got = est.estimate(y[:, :50], u[:, :50], SUN.xhat0, keep_covariance=keep, backend="numba")
             if keep is False:
                 assert got.P is None and ref.P is None
@@ -162,7 +171,7 @@ def test_backend_options_checked(chaser_truth):
     est = build_estimator(SUN, "hbf")
     with pytest.raises(hn.InputError, match="backend"):
         est.estimate(y, u, SUN.xhat0, backend="fortran")
-    with pytest.raises(hn.InputError, match="diagnostics"):
+    with pytest.raises(hn.InputError, match="diagnostics other than innovation"):
         est.estimate(y, u, SUN.xhat0, diagnostics=True, backend="numba")
     assert select_backend(est, "auto", None) == "numpy"  # diagnostics asked: the NumPy path
     est.missing = "skip"

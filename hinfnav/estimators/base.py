@@ -448,9 +448,9 @@ class Estimator:
         y, u, xhat0 = check_estimator_inputs(y, u, xhat0, self.n_state, self.measurement.n_meas,
                                              self.n_input if self.uses_input else None, self.missing)
         if select_backend(self, backend, keys) == "numba":
-            xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
+            xhat, P_hist, diag = run_compiled(self, y, u, xhat0, P0, keep_covariance, keys)
             if xhat is not None:  # else a factorisation failed: the NumPy path raises (or flags) as it says
-                return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)
+                return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state, diagnostics=diag)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks

@@ -62,6 +62,7 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice
 from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
+from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
 
 __all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
            "run_compiled", "select_backend", "use_backend", "why_numpy"]
@@ -180,8 +181,9 @@ def why_numpy(est: Any, diagnostics: set | bool | None = frozenset()) -> str | N
     elif diagnostics is False:
         diagnostics = frozenset()
     reason = kernel_status(est)
-    if reason is None and (diagnostics is None or diagnostics):
-        reason = "diagnostics are computed on the NumPy path only (pass diagnostics=False)"
+    if reason is None and (diagnostics is None or not set(diagnostics) <= set(NIS_DIAGNOSTICS)):
+        reason = (f"diagnostics other than {', '.join(NIS_DIAGNOSTICS)} are computed on the NumPy path only (asked: "
+                  f"{'all' if diagnostics is None else ', '.join(sorted(set(diagnostics) - set(NIS_DIAGNOSTICS)))})")
     if reason is None and not numba_available():
         reason = "numba is not installed (pip install numba==0.68.1)"
     return reason
@@ -217,8 +219,14 @@ def _per_run(value, runs):
 
 
 def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: np.ndarray | None,
-                 keep_covariance: bool | str) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """``(xhat, P history)`` of ``est`` on checked inputs by its kernel, or ``(None, None)`` to fall back.
+                 keep_covariance: bool | str, diagnostics: set = frozenset()
+                 ) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
+    """``(xhat, P history, diagnostics)`` of ``est`` on checked inputs by its kernel, or ``(None, None, {})`` to
+    fall back.
+
+    ``diagnostics``: names among :data:`~.compiled_diagnostics.NIS_DIAGNOSTICS`
+    (computed from the kernel's histories by
+    :func:`~.compiled_diagnostics.nis_diagnostics`).
 
     ``y`` (runs, n_samples, m), ``u`` (runs, n_samples, n_input) and ``xhat0``
     as :func:`~hinfnav.estimators.base.check_estimator_inputs` returns them.
@@ -235,10 +243,12 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     P_start = _float(state.P if state.P.ndim == 2 else state.P[0])
     y = _float(y)
     u = _float(u) if u.shape[2] else np.zeros((runs, steps, 1))
-    keep = {False: 0, "diagonal": 1, True: 2}[keep_covariance]
+    keep = want_keep = {False: 0, "diagonal": 1, True: 2}[keep_covariance]
+    if diagnostics and kind != "recursive_hinf":
+        keep = 2  # the posterior covariances give S
     use_input = bool(est.uses_input)
     H = _float(est.measurement.H)
-    shared = False
+    shared = strong = False
     if kind in ("kalman", "augmented"):
         strong, huber = bool(getattr(est, "strong_tracking", False)), bool(getattr(est, "huber_correction", False))
         shared = bool(est.shares_covariance)
@@ -258,6 +268,9 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
         shared = True
     if G is None or G.shape[1] != u.shape[2]:
         G = np.zeros((n, u.shape[2]))
+    n_out = n_rep
+    if diagnostics:
+        n_rep = n  # the whole (augmented) state: the priors follow from it
     xhat = np.empty((runs, steps, n_rep))
     p_runs = 1 if shared else runs
     Pdiag = np.empty((p_runs, steps, n_rep)) if keep == 1 else np.empty((1, 1, 1))
@@ -281,10 +294,26 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
         ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est.G_theta), _float(est.HtRi), P_start, x0, y, u,
                                        use_input, _kernel_steady_tol(est), keep, xhat, Pdiag, Pfull)
     if not ok:
-        return None, None
+        return None, None, {}
+    diag = {}
+    if diagnostics:
+        filtered = kind != "recursive_hinf" and est.output == "filtered"
+        Qd_used = _float(est.Qd if kind == "augmented" else est.Q)
+        diag = nis_diagnostics(est, diagnostics, F=F, G=G, H=H, Qd=Qd_used, R=_float(est.R), P_start=P_start, x0=x0,
+                               y=y, u=u, use_input=use_input, filtered=filtered, xhat=xhat,
+                               P=Pfull if keep == 2 else None, strong=kind != "recursive_hinf" and strong,
+                               with_S=kind != "recursive_hinf")
+        xhat = np.ascontiguousarray(xhat[:, :, :n_out])
+        if want_keep == 0:
+            Pfull = None
+        elif want_keep == 1:
+            Pdiag = np.ascontiguousarray(np.diagonal(Pfull, axis1=-2, axis2=-1)[:, :, :n_out])
+        elif keep == 2 and n_out < n_rep:
+            Pfull = np.ascontiguousarray(Pfull[:, :, :n_out, :n_out])
+        keep = want_keep
     P_hist = {0: None, 1: Pdiag, 2: Pfull}[keep]
     if P_hist is not None and shared:
         P_hist = P_hist[0]
         P_hist.setflags(write=False)
         P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
-    return xhat, P_hist
+    return xhat, P_hist, diag
