@@ -50,16 +50,16 @@ NAMES = registered_estimators()
 
 #: The registered estimators that have a kernel on their scenario (a kernel lost by a refactoring fails here).
 WITH_KERNEL = {"ekf", "ekf_known_input", "recursive_hinf", "ekf_augmented_thrust", "ekf_augmented_thrust_st", "hbf",
-               "ukf", "stekf", "model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_hinf", "huber_stekf"}
-#: ... and those that fall back: the LTI filters (already one vectorised recursion), the attitude filters
-#: (quaternion states), the rate-adaptive filter (data-dependent Q), the converted measurement (R from the
-#: reading), Yang 2020's extended-state filters (their own hooks), the benchmark's rate-adapted random-walk filter
-#: (data-dependent Q) and its LMI observer (an LTI filter).
+               "ukf", "stekf", "model_ekf", "model_ukf", "model_hbf", "model_stekf", "model_hinf", "huber_stekf",
+               "published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
+               "designed_observer_closed_loop", "model_lmi"}
+#: ... and those that fall back: the attitude filters (quaternion states), the rate-adaptive filter (data-dependent
+#: Q), the converted measurement (R from the reading), Yang 2020's extended-state filters (their own hooks) and the
+#: benchmark's rate-adapted random-walk filter (data-dependent Q).
 #: The benchmark's other generic filters are built on Sun's chaser, whose declared Kalman model they fit first.
-WITHOUT_KERNEL = {"published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
-                  "designed_observer_closed_loop", "aekf", "astekf", "aaekf", "ekf_augmented_thrust_adaptive",
+WITHOUT_KERNEL = {"aekf", "astekf", "aaekf", "ekf_augmented_thrust_adaptive",
                   "ekf_converted", "yang2020_alg1", "yang2020_alg2", "yang2020_alg2_ideal", "yang2020_alg2_skip",
-                  "yang2020_fused", "attitude_hbf", "attitude_ukf", "model_adaptive", "model_lmi"}
+                  "yang2020_fused", "attitude_hbf", "attitude_ukf", "model_adaptive"}
 
 
 def _scenario(name):
@@ -199,6 +199,29 @@ def test_auto_is_the_default_and_says_why_it_falls_back(chaser_truth, monkeypatc
     monkeypatch.setenv(compiled.BACKEND_VARIABLE, "fortran")
     with pytest.raises(hn.InputError, match="HINFNAV_BACKEND"):
         select_backend(est, None)
+
+
+def test_lti_filter_kernel_with_missing_readings(chaser_truth):
+    # the LTI filter (12) (the published and designed filters): the kernel equals the NumPy loop to 1e-10,
+    # with the known-input correction and with missing='skip' (a NaN reading replaced by H x̂, as on the NumPy path)
+    y, u = chaser_truth
+    for name in ("published", "published_closed_loop", "designed_observer"):
+        est = _built(name, on_sun=True)
+        ref = est.estimate(y, u, SUN.xhat0, backend="numpy", diagnostics=NIS_KEYS)
+        got = est.estimate(y, u, SUN.xhat0, backend="numba", diagnostics=NIS_KEYS)
+        _assert_same(ref, got, name)
+        assert got.diagnostics == ref.diagnostics == {}
+    est = _built("published", on_sun=True)
+    y_gap = y.copy()
+    y_gap[:, 40:60, 1] = np.nan
+    y_gap[3, 100:120] = np.nan
+    est.missing = "skip"
+    try:
+        assert kernel_status(est) is None
+        _assert_same(est.estimate(y_gap, u, SUN.xhat0, backend="numpy"),
+                     est.estimate(y_gap, u, SUN.xhat0, backend="numba"), "lti skip")
+    finally:
+        est.missing = "refuse"
 
 
 def test_kernels_are_declared_by_the_class_itself():

@@ -71,7 +71,7 @@ __all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel
 BACKENDS = ("numpy", "numba", "auto")
 
 #: The kernels a filter class may declare (its ``compiled_kernel`` attribute).
-KERNELS = ("kalman", "augmented", "sigma_point", "recursive_hinf")
+KERNELS = ("kalman", "augmented", "sigma_point", "recursive_hinf", "lti")
 
 #: The environment variable that sets the backend of every ``estimate`` not given one (``python -m hinfnav
 #: ... --backend`` sets it, so that worker processes inherit it).
@@ -152,8 +152,13 @@ def kernel_status(est: Any) -> str | None:
         return (f"no kernel for {type(est).__name__}" + (
             f" (its base class declares the {inherited!r} kernel; a subclass that changes a hook declares "
             "compiled_kernel itself to keep it)" if inherited else " (the class declares no compiled_kernel)"))
+    if kind == "lti":
+        if est.missing == "skip" and (not getattr(est.measurement, "linear", False)
+                                      or getattr(est.measurement, "H", None) is None):
+            return "missing='skip' replaces a missing reading by h(x̂): on the compiled path for a linear h only"
+        return None
     if est.missing != "refuse":
-        return "missing='skip' runs on the NumPy path only"
+        return "missing='skip' runs on the NumPy path only (except for the LTI filter)"
     system = est.system
     if not isinstance(system, LinearSystem) or type(system).propagate is not LinearSystem.propagate:
         return "its system is not a hinfnav LinearSystem"
@@ -238,6 +243,15 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     kern = _kernels()
     kind = _kind(est)
     runs, steps, _ = y.shape
+    if kind == "lti":
+        xhat = np.empty((runs, steps, est.n_state))
+        use_input = bool(est.uses_input)
+        M = _float(est.input_correction) if use_input else np.zeros((est.n_state, 1))
+        H = _float(est.measurement.H) if est.missing == "skip" else np.zeros((y.shape[2], est.n_state))
+        ok = kern.lti_batch(_float(est.A_effective), _float(est.B_F), _float(est.C_F), M, H,
+                            _float(est.start(xhat0, None, 1).x[0]), _float(y), _float(u) if use_input else
+                            np.zeros((runs, steps, 1)), use_input, est.missing == "skip", xhat)
+        return (xhat, None, {}) if ok else (None, None, {})
     state = est.start(xhat0, P0, runs)  # the filter's own checks of P0 and its per-run parameters
     x0 = _float(state.x[0])
     P_start = _float(state.P if state.P.ndim == 2 else state.P[0])
