@@ -244,3 +244,23 @@ def test_kernels_are_declared_by_the_class_itself():
 def test_numba_not_imported_without_the_backend():
     code = "import sys, hinfnav.estimators; import hinfnav.papers; assert 'numba' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_every_cell_of_the_example_campaign_runs_compiled():
+    # benchmarks/campaign_example.toml: every cell's estimator, with the NIS inputs the runner asks for
+    # (diagnostics=NIS_KEYS), runs on its kernel under the default backend "auto" (why_numpy is None)
+    from pathlib import Path
+
+    from hinfnav.campaign import build_scenario, load_campaign
+
+    campaign = load_campaign(Path(__file__).parents[1] / "benchmarks" / "campaign_example.toml")
+    seen = set()
+    for cell in campaign.cells():
+        key = (cell.scenario, repr(sorted(cell.settings.items())), cell.estimator, repr(sorted(cell.options.items())))
+        if key in seen:
+            continue
+        seen.add(key)
+        est = build_estimator(build_scenario(cell.scenario, **cell.settings), cell.estimator, **cell.options)
+        assert compiled.why_numpy(est, set(NIS_KEYS)) is None, (cell.estimator, compiled.why_numpy(est, set(NIS_KEYS)))
+        assert select_backend(est, None, set(NIS_KEYS)) == "numba"
+    assert len(seen) >= 5
