@@ -11,8 +11,8 @@ the filters that use it; the strong-tracking filter is the registered
 and 10⁴ runs (the larger batches on fewer steps), the CPU time per step of
 the whole batch:
 
-* **NumPy**: ``est.estimate(..., backend="numpy")``, today's reference path;
-* **numba**: ``est.estimate(..., backend="numba")`` (kernels already compiled
+* **NumPy**: ``est.estimate(..., backend="numpy")``, the reference path;
+* **numba**: ``est.estimate(..., backend="numba")``, what the default ``"auto"`` runs (kernels already compiled
   and cached: the first call's cost is printed separately, with
   ``--compile-cost`` from a cold and from a warm cache);
 * **filterpy**: filterpy 2.0's loop (``predict``/``update`` per run and

@@ -264,3 +264,13 @@ def test_every_cell_of_the_example_campaign_runs_compiled():
         assert compiled.why_numpy(est, set(NIS_KEYS)) is None, (cell.estimator, compiled.why_numpy(est, set(NIS_KEYS)))
         assert select_backend(est, None, set(NIS_KEYS)) == "numba"
     assert len(seen) >= 5
+
+
+def test_cli_backend_option():
+    # python -m hinfnav --backend {auto,numpy,numba} COMMAND: the choice is checked by the parser
+    from hinfnav.cli import _parser
+
+    assert _parser().parse_args(["--backend", "numpy", "reproduce"]).backend == "numpy"
+    assert _parser().parse_args(["reproduce"]).backend is None  # HINFNAV_BACKEND or "auto"
+    with pytest.raises(SystemExit):
+        _parser().parse_args(["--backend", "fortran", "reproduce"])
