@@ -237,6 +237,11 @@ def inv_spd(S):
     S = np.asarray(S, dtype=float)
     m = S.shape[-1]
     batch = S.size // max(1, m * m)
+    if m == 1:  # the same operations: d = √s, (1/d)/d (the forward and the back substitution)
+        s = S[..., 0, 0]
+        if (s > 0).all() and (s < np.inf).all():
+            d = np.sqrt(s)
+            return ((1.0 / d) / d)[..., None, None]
     if m <= ELEMENTWISE_SIZE and batch <= SCALAR_BATCH:  # a few matrices: Python floats cost less than arrays
         rows = S.reshape(batch, m, m).tolist()
         inv = [_chol_inv_one(Sb) for Sb in rows]
