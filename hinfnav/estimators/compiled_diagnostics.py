@@ -11,8 +11,8 @@ equations, vectorised over runs and steps:
   ``νₖ = yₖ − H x̂⁻ₖ``;
 * ``P⁻₀ = P₀``, ``P⁻ₖ = F P⁺ₖ₋₁ Fᵀ + Q_d``; with strong tracking the faded
   ``Λ^{1/2} F P⁺ₖ₋₁ Fᵀ Λ^{1/2} + Q_d``, Λ from the innovations by (S1)-(S3)
-  (:func:`~hinfnav.estimators.adaptive.fading_factors`, the NumPy path's
-  function); ``Sₖ = H P⁻ₖ Hᵀ + R``.
+  (the filter's :meth:`~hinfnav.estimators.adaptive.StrongTracking.fade_prior`,
+  the NumPy path's functions); ``Sₖ = H P⁻ₖ Hᵀ + R``.
 
 On a linear model these are the NumPy path's numbers up to the order of the
 floating-point sums (``tests/test_compiled.py`` compares them to 1e-10).
@@ -24,7 +24,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.linalg import congruence
-from .adaptive import fade, fading_factors, innovation_moment
 
 __all__ = ["NIS_DIAGNOSTICS", "nis_diagnostics"]
 
@@ -56,14 +55,10 @@ def nis_diagnostics(est, keys, *, F, G, H, Qd, R, P_start, x0, y, u, use_input, 
             P_prior = np.empty(P.shape)
             P_prior[:, 0] = P_start
             PPT = congruence(F, P[:, :-1])
-            if strong:
-                rho = np.broadcast_to(np.asarray(est.rho, dtype=float), (runs,))
-                beta = np.broadcast_to(np.asarray(est.beta, dtype=float), (runs,))
+            if strong:  # the filter's own (S1)-(S4)
                 V0 = None
                 for k in range(1, steps):
-                    V0 = innovation_moment(V0, nu[:, k], rho)
-                    lam, _ = fading_factors(V0, H, PPT[:, k - 1], Qd, R, beta=beta, a=est.a)
-                    P_prior[:, k] = fade(PPT[:, k - 1], lam) + Qd
+                    P_prior[:, k], V0 = est.fade_prior(PPT[:, k - 1], Qd, V0, nu[:, k], H)
             else:
                 P_prior[:, 1:] = PPT + Qd
         else:
