@@ -11,8 +11,8 @@ the filters that use it; the strong-tracking filter is the registered
 and 10⁴ runs (the larger batches on fewer steps), the CPU time per step of
 the whole batch:
 
-* **NumPy**: ``est.estimate(..., backend="numpy")``, today's reference path;
-* **numba**: ``est.estimate(..., backend="numba")`` (kernels already compiled
+* **NumPy**: ``est.estimate(..., backend="numpy")``, the reference path;
+* **numba**: ``est.estimate(..., backend="numba")``, what the default ``"auto"`` runs (kernels already compiled
   and cached: the first call's cost is printed separately, with
   ``--compile-cost`` from a cold and from a warm cache);
 * **filterpy**: filterpy 2.0's loop (``predict``/``update`` per run and
@@ -106,6 +106,8 @@ def flops(kind, n=6, m=3, nu=3, n_aug=3):
     if kind == "strong":  # augmented by n_aug input states (no G u), plus (S1)-(S4)
         na = n + n_aug
         return flops("joseph", na, m, 0) + 2 * m * m + 2 * m * na * na + 2 * m * m * na + 2 * na * m + 3 * na * na
+    if kind == "lti":  # x̂ = C_F x_f, x_f⁺ = A x_f + B_F y + M u
+        return 2 * n * n + 2 * n * n + 2 * n * m + 2 * n * nu + n
     if kind == "ukf":
         N = 2 * n + 1
         return 2 * (n**3 / 3) + 2 * N * n * m + 4 * N * m * m + 2 * N * n * m + m**3 + 2 * n * m * m + 2 * n * m \
@@ -181,7 +183,31 @@ def filters(sc):
         "Huber": (HuberFilter.from_ekf(ekf), None, "huber", None),
         "strong tracking": (build_estimator(sc, "ekf_augmented_thrust_st"), None, "strong", None),
         "recursive H∞": (build_estimator(sc, "recursive_hinf"), None, "shared", "joseph"),
+        "LTI filter (12)": (build_estimator(sc, "published_closed_loop"), None, "lti", None),
     }
+
+
+def constant_turn_rows(repeat, steps=2000):
+    """µs per step of the EKF and the sigma-point filter on the README's own-model example (constant turn,
+    range/bearing; one run): the default backend, the NumPy path, and why the default is not compiled."""
+    from hinfnav.estimators import ExtendedKalmanFilter, SigmaPointFilter
+    from hinfnav.estimators.compiled import why_numpy
+    from hinfnav.systems import ConstantTurn, RangeBearing
+
+    model = ConstantTurn(dt=1.0, sigma_accel=0.05, sigma_turn_rate=1e-3)
+    sensor = RangeBearing(model.n, sigma_range=5.0, sigma_bearing=0.01)
+    x0, P0 = np.array([-1500.0, 400.0, 0.0, -15.0, 0.03]), np.diag([50, 50, 5, 5, 0.02]) ** 2.0
+    x = [x0[None]]
+    for _ in range(steps - 1):
+        x.append(model.f(x[-1]))
+    y = sensor.measure(np.stack(x, 1), np.random.default_rng(0).standard_normal((1, steps, 2)))
+    u = np.zeros((1, steps, 0))
+    rows = []
+    for est in (ExtendedKalmanFilter(model, sensor, P0=P0), SigmaPointFilter(model, sensor, P0=P0)):
+        t_def, _ = _min_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False), repeat)
+        t_np, _ = _min_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False, backend="numpy"), repeat)
+        rows.append((type(est).__name__, t_def * 1e6 / steps, t_np * 1e6 / steps, why_numpy(est) or "compiled"))
+    return rows
 
 
 _FIRST_CALL = """import os, sys, time
@@ -232,7 +258,11 @@ def main(argv=None):
     sizes = [(args.big_runs if runs == 10_000 else runs, steps) for runs, steps in (QUICK if args.quick else SIZES)]
     longest = max(s for _, s in sizes)
     sc = Scenario(duration_s=longest * 0.1, rms_window_s=(0.0, longest * 0.1))
-    truth = simulate_truth(sc.truth_model(maneuver=True), runs=max(r for r, _ in sizes), seed=0)
+    truths = {}  # one truth per (runs, steps), simulated for its steps only (memory: that of the largest batch)
+    for runs, steps in sizes:
+        sc_k = Scenario(duration_s=steps * 0.1, rms_window_s=(0.0, steps * 0.1))
+        truths[runs, steps] = simulate_truth(sc_k.truth_model(maneuver=True), runs=runs, seed=0)
+    truth = truths[sizes[0]]
     table = filters(sc)
     t0 = time.perf_counter()
     for est, *_ in table.values():  # first call: numba imported, kernels loaded from the cache (or compiled)
@@ -249,7 +279,7 @@ def main(argv=None):
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, (est, fp, kind, shared) in table.items():
         for runs, steps in sizes:
-            y, u = truth.y[:runs, :steps], truth.u[:runs, :steps]
+            y, u = truths[runs, steps].y[:, :steps], truths[runs, steps].u[:, :steps]
 
             def run(backend, est=est, y=y, u=u):
                 return est.estimate(y, u, sc.xhat0, keep_covariance=False, backend=backend).xhat
@@ -271,6 +301,11 @@ def main(argv=None):
             work = flops(kind) * runs + (flops(shared) if shared else 0)
             cells += [f"{work / rate * 1e6:.3f}", f"{_rel(ref, got):.0e}", d_fp]
             print(f"| {name} | {runs} × {steps} | " + " | ".join(cells) + " |", flush=True)
+    print("\nYour own nonlinear model (the README's constant-turn target, range/bearing sensor; 1 run x 2000 steps):")
+    print("| filter | default µs/step | NumPy µs/step | default backend |")
+    print("|---|---:|---:|---|")
+    for name, t_def, t_np, why in constant_turn_rows(args.repeat, 200 if args.quick else 2000):
+        print(f"| {name} | {t_def:.1f} | {t_np:.1f} | {why} |", flush=True)
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end; each cell the least of {args.repeat} CPU-time "
           "timings of the whole batch divided by its steps (filterpy: of fewer, on at most 20 runs, scaled to the "
           "runs); Δ: largest |x̂ − x̂_NumPy| over runs and steps, each state channel over its largest |x̂_NumPy|")

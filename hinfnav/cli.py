@@ -279,6 +279,9 @@ def _parser():
                     "(base: Sun et al. 2011, robust H-infinity filtering for a chaser satellite).",
     )
     p.add_argument("--version", action=_VersionAction, help="print hinfnav's version and exit")
+    p.add_argument("--backend", default=None, choices=("auto", "numpy", "numba"),
+                   help="how the filters run: their compiled kernel where one exists (auto, the default), the NumPy "
+                        "reference, or the kernel only (numba); sets HINFNAV_BACKEND for every worker")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
@@ -376,6 +379,9 @@ def main(argv=None):
         parser.error(f"--jobs must be >= 1; got {args.jobs}")
     if getattr(args, "verbatim", False) and args.design is None:
         parser.error("--verbatim applies to --design only")
+    old_backend = os.environ.get("HINFNAV_BACKEND")
+    if args.backend is not None:
+        os.environ["HINFNAV_BACKEND"] = args.backend  # read by every estimate (compiled.default_backend), workers too
     try:
         args.func(args)
     except HinfnavError as exc:
@@ -393,4 +399,9 @@ def main(argv=None):
         # a file system refusal the checks could not foresee (permissions, a full disk): say it, no traceback
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    finally:
+        if old_backend is None:
+            os.environ.pop("HINFNAV_BACKEND", None)
+        else:
+            os.environ["HINFNAV_BACKEND"] = old_backend
     return 0

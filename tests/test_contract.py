@@ -150,7 +150,8 @@ def test_run_by_run_equals_vectorized(case):
 
 def test_step_loop_equals_batch_estimate(case):
     sc, est, truth = case.scenario, case.estimator, case.truth
-    batch = est.estimate(truth.y, truth.u, sc.xhat0)
+    # the step interface is the NumPy path's (the compiled default equals it to 1e-10: tests/test_compiled.py)
+    batch = est.estimate(truth.y, truth.u, sc.xhat0, backend="numpy")
     state = est.start(sc.xhat0, None, truth.x.shape[0])
     n1 = truth.x.shape[1]
     xhat = np.empty_like(batch.xhat)

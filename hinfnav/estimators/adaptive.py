@@ -196,6 +196,8 @@ class StrongTracking:
 
     data_dependent_covariance = True
     defers_prior = True
+    #: The prior is faded by (S1)-(S4) (read by the compiled kernels).
+    strong_tracking = True
 
     def __init__(self, *args: Any, rho: float = 0.95, beta: float = 1.0, a: ArrayLike | None = None,
                  **kwargs: Any) -> None:
@@ -208,6 +210,15 @@ class StrongTracking:
         if a.shape != (self.n_cov,) or not np.all(np.isfinite(a)) or np.any(a < 1):
             raise InputError(f"a (prior weights of the fading factors) must be {self.n_cov} numbers >= 1; got {a}")
         self.a = a
+
+    def fade_prior(self, PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], V0: NDArray[np.float64] | None,
+                   innovation: NDArray[np.float64], H: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(S1)-(S4) on arrays, every channel read: ``(P⁻, V₀)`` from the moment ``V0`` (None at the first
+        reading), the innovation (runs, m) and ``Φ P Φᵀ``; what :meth:`complete_prior` computes without missing
+        channels (the compiled path's NIS diagnostics use it)."""
+        V0 = innovation_moment(V0, innovation, self.rho)
+        lam, _ = fading_factors(V0, H, PhiPPhiT, Qd, self.R, beta=self.beta, a=self.a)
+        return fade(PhiPPhiT, lam) + Qd, V0
 
     def complete_prior(self, PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], state: FilterState, innovation: NDArray[np.float64], H: NDArray[np.float64],
                        mask: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:

@@ -216,6 +216,9 @@ class AugmentedInputKF(AugmentedEKF):
 
     name = "augmented input kf"
 
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "augmented"
+
     def __init__(self, system: LinearSystem, measurement: MeasurementModel, *, Q_input: ArrayLike, P0: ArrayLike,
                  P0_input: ArrayLike | None = None, Q: ArrayLike | None = None, R: ArrayLike | None = None, output: str = "filtered",
                  name: str | None = None, missing: str = "refuse") -> None:
@@ -270,11 +273,19 @@ class AugmentedInputKF(AugmentedEKF):
     def augmented(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         return x[:, self._n:]
 
+    @property
+    def H_augmented(self) -> np.ndarray | None:
+        """``[H 0]``, the measurement matrix on the augmented state (a linear measurement), else None."""
+        return getattr(self, "_H", None)
+
 
 class AugmentedInputSTKF(StrongTracking, AugmentedInputKF):
     """:class:`AugmentedInputKF` with strong tracking (fading factors; ``rho``, ``beta``, ``a``)."""
 
     name = "augmented input stkf"
+
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "augmented"
 
 
 class AugmentedInputAdaptiveKF(RateAdaptive, AugmentedInputKF):
@@ -292,3 +303,6 @@ class AugmentedInputHuberSTKF(HuberCorrection, StrongTracking, AugmentedInputKF)
     """
 
     name = "augmented input huber stkf"
+
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "augmented"

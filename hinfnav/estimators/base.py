@@ -301,6 +301,9 @@ class Estimator:
                     raise InputError(f"{type(self).__name__}.{name} must be a finite array of shape {old_arr.shape}; "
                                      f"got shape {arr.shape}")
         object.__setattr__(self, name, value)
+    #: The compiled kernel a class declares in its own body (one of
+    #: :data:`hinfnav.estimators.compiled.KERNELS`), None: the NumPy path only.
+    compiled_kernel = None
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, name: str | None = None,
                  missing: str = "refuse") -> None:
@@ -507,7 +510,7 @@ class Estimator:
 
     def estimate(self, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike, P0: ArrayLike | None = None, *,
                  keep_covariance: bool | str = True, diagnostics: bool | Iterable[str] = False,
-                 backend: str = "numpy") -> EstimateHistory:
+                 backend: str | None = None) -> EstimateHistory:
         """Estimate the state histories of a batch of runs.
 
         Parameters
@@ -528,9 +531,12 @@ class Estimator:
         diagnostics : bool or iterable of str
             Return the diagnostics histories: all (True), none (False), or
             those named.
-        backend : {"numpy", "numba", "auto"}
-            The NumPy step loop (the reference), a compiled kernel, or the
-            kernel where one exists (see :mod:`hinfnav.estimators.compiled`).
+        backend : {"auto", "numpy", "numba"}, optional
+            The kernel where one exists (the default, unless the environment
+            variable ``HINFNAV_BACKEND`` says otherwise), the NumPy step loop
+            (the reference), or a compiled kernel (an InputError if none
+            fits); see :mod:`hinfnav.estimators.compiled` and its
+            :func:`~hinfnav.estimators.compiled.why_numpy`.
 
         Returns
         -------
@@ -549,10 +555,10 @@ class Estimator:
                 raise InputError("backend='numba' takes one xhat0 (n,) for every run; use backend='numpy' (or "
                                  "'auto') with one initial estimate per run")
         elif select_backend(self, backend, keys) == "numba":
-            xhat, P_hist = run_compiled(self, y, u, xhat0, P0, keep_covariance)
+            xhat, P_hist, diag = run_compiled(self, y, u, xhat0, P0, keep_covariance, keys)
             if xhat is not None and np.isfinite(xhat).all() and (P_hist is None or np.isfinite(P_hist).all()):
                 # else a factorisation failed or a number is not finite: the NumPy path raises at its step
-                return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state)
+                return EstimateHistory(xhat=xhat, P=P_hist, state=self.system.state, diagnostics=diag)
         core = 1 if keep_covariance == "diagonal" else 2
         runs, n1, _ = y.shape
         state = self.start(xhat0, P0, runs)  # checked once; the loop calls the hooks

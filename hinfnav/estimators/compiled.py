@@ -2,15 +2,27 @@
 
 ``est.estimate(y, u, xhat0, P0, backend=...)`` chooses how the batch runs:
 
-* ``"numpy"`` (the default): the NumPy step loop, the reference of every
-  number the workbook reports;
+* ``"auto"`` (the default, or the environment variable ``HINFNAV_BACKEND``
+  when it is set: :func:`default_backend`): the kernel where one exists, the
+  NumPy path otherwise; :func:`why_numpy` says why a filter falls back (and
+  the ``hinfnav.backend`` logger reports it at INFO level);
+* ``"numpy"``: the NumPy step loop, the reference of every number the
+  workbook reports;
 * ``"numba"``: a compiled kernel (:mod:`hinfnav.estimators.compiled_kernels`)
   that runs every run over every step in one call. It exists for the filters
-  listed by :func:`kernel_status` on a linear system with a constant
-  measurement matrix (``y = H x + D v``), a constant R, ``missing="refuse"``
-  and no diagnostics requested; for any other estimator or option the request
-  raises an :class:`~hinfnav.core.exceptions.InputError` that says why;
-* ``"auto"``: the kernel where one exists, the NumPy path otherwise.
+  that declare one (the class attribute ``compiled_kernel``, one of
+  :data:`KERNELS`, set in the class's own body: a subclass that changes a hook
+  does not inherit it) on a linear system with a constant measurement matrix
+  (``y = H x + D v``), a constant R, ``missing="refuse"`` and no diagnostics
+  requested; for any other estimator or option the request raises an
+  :class:`~hinfnav.core.exceptions.InputError` that says why.
+
+A filter that declares a kernel gives it what it needs through public
+attributes: the model (``F``/``Gamma``/``Q``/``R`` or the augmented ``Phi_a``,
+``Qd``, ``H_augmented``), strong tracking's ``rho``/``beta``/``a`` (the
+mixin's ``strong_tracking`` flag), Huber's ``gamma``/``tol``/``max_iter``
+and ``whitening_matrix`` (the mixin's ``huber_correction`` flag), the
+recursive H∞ filter's ``G_theta`` and ``HtRi``.
 
 The kernels give the NumPy path's estimates and covariances to 1e-10 relative
 (``tests/test_compiled.py`` checks every registered estimator); the
@@ -36,8 +48,12 @@ load).
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
+import logging
+import os
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -46,23 +62,22 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice
 from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
+from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
 
-__all__ = ["BACKENDS", "KERNEL_CLASSES", "kernel_status", "numba_available", "run_compiled", "select_backend"]
+__all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
+           "run_compiled", "select_backend", "use_backend", "why_numpy"]
 
 #: What ``Estimator.estimate(backend=...)`` accepts.
 BACKENDS = ("numpy", "numba", "auto")
 
-#: The estimator classes (of :mod:`hinfnav.estimators`, exactly: a subclass may change a hook) that have a kernel.
-KERNEL_CLASSES = {
-    "ExtendedKalmanFilter": "kalman",
-    "StrongTrackingEKF": "kalman",
-    "HuberFilter": "kalman",
-    "AugmentedInputKF": "augmented",
-    "AugmentedInputSTKF": "augmented",
-    "AugmentedInputHuberSTKF": "augmented",
-    "SigmaPointFilter": "sigma_point",
-    "RecursiveHInfinityFilter": "recursive_hinf",
-}
+#: The kernels a filter class may declare (its ``compiled_kernel`` attribute).
+KERNELS = ("kalman", "augmented", "sigma_point", "recursive_hinf", "lti")
+
+#: The environment variable that sets the backend of every ``estimate`` not given one (``python -m hinfnav
+#: ... --backend`` sets it, so that worker processes inherit it).
+BACKEND_VARIABLE = "HINFNAV_BACKEND"
+
+_LOG = logging.getLogger("hinfnav.backend")
 
 _KERNELS = {}
 
@@ -85,15 +100,37 @@ def _kernels():
     return _KERNELS["module"]
 
 
+def default_backend() -> str:
+    """The backend of an ``estimate`` called without one: ``$HINFNAV_BACKEND`` if set, else "auto"."""
+    return as_choice(BACKEND_VARIABLE, os.environ.get(BACKEND_VARIABLE, "auto"), BACKENDS)
+
+
+@contextlib.contextmanager
+def use_backend(backend: str | None) -> Iterator[None]:
+    """Within the block, every ``estimate`` called without a backend uses ``backend`` (None: leave it as it is).
+
+    Sets :data:`BACKEND_VARIABLE` in the environment (so that worker processes
+    started within the block inherit it) and restores it after.
+    """
+    if backend is None:
+        yield
+        return
+    backend = as_choice("backend", backend, BACKENDS)
+    old = os.environ.get(BACKEND_VARIABLE)
+    os.environ[BACKEND_VARIABLE] = backend
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(BACKEND_VARIABLE, None)
+        else:
+            os.environ[BACKEND_VARIABLE] = old
+
+
 def _kind(est):
-    cls = type(est)
-    if not cls.__module__.startswith(f"{__package__}.") or cls.__name__ not in KERNEL_CLASSES:
-        return None
-    return KERNEL_CLASSES[cls.__name__]
-
-
-def _mro_names(est):
-    return {c.__name__ for c in type(est).__mro__}
+    """The kernel declared by the estimator's own class (``compiled_kernel`` in its body), or None."""
+    kind = vars(type(est)).get("compiled_kernel")
+    return kind if kind in KERNELS else None
 
 
 def _linear_measurement(est):
@@ -111,10 +148,17 @@ def kernel_status(est: Any) -> str | None:
     """Why ``est`` has no compiled kernel, or None when it has one (diagnostics aside)."""
     kind = _kind(est)
     if kind is None:
-        return (f"no kernel for {type(est).__name__} (kernels: {', '.join(sorted(KERNEL_CLASSES))}, exactly these "
-                "classes of hinfnav.estimators)")
+        inherited = getattr(type(est), "compiled_kernel", None)
+        return (f"no kernel for {type(est).__name__}" + (
+            f" (its base class declares the {inherited!r} kernel; a subclass that changes a hook declares "
+            "compiled_kernel itself to keep it)" if inherited else " (the class declares no compiled_kernel)"))
+    if kind == "lti":
+        if est.missing == "skip" and (not getattr(est.measurement, "linear", False)
+                                      or getattr(est.measurement, "H", None) is None):
+            return "missing='skip' replaces a missing reading by h(x̂): on the compiled path for a linear h only"
+        return None
     if est.missing != "refuse":
-        return "missing='skip' runs on the NumPy path only"
+        return "missing='skip' runs on the NumPy path only (except for the LTI filter)"
     system = est.system
     if not isinstance(system, LinearSystem) or type(system).propagate is not LinearSystem.propagate:
         return "its system is not a hinfnav LinearSystem"
@@ -130,24 +174,42 @@ def kernel_status(est: Any) -> str | None:
     return None
 
 
-def select_backend(est: Any, backend: str, diagnostics: set | None = frozenset()) -> str:
-    """The backend that runs ``est.estimate``: "numpy" or "numba" (see the module docstring).
+def why_numpy(est: Any, diagnostics: set | bool | None = frozenset()) -> str | None:
+    """Why ``backend="auto"`` runs ``est`` on the NumPy path, or None when it runs its kernel.
 
-    ``diagnostics`` is what :func:`hinfnav.estimators.base.history_keys` returns
-    (None: all). Raises InputError naming ``backend`` when "numba" is asked for
-    and no kernel fits.
+    ``diagnostics`` as :meth:`~hinfnav.estimators.base.Estimator.estimate`
+    takes it (True/False or names) or as
+    :func:`~hinfnav.estimators.base.history_keys` returns it (a set; None: all).
     """
-    backend = as_choice("backend", backend, BACKENDS)
-    if backend == "numpy":
-        return "numpy"
+    if diagnostics is True:
+        diagnostics = None
+    elif diagnostics is False:
+        diagnostics = frozenset()
     reason = kernel_status(est)
-    if reason is None and (diagnostics is None or diagnostics):
-        reason = "diagnostics are computed on the NumPy path only (pass diagnostics=False)"
+    if reason is None and (diagnostics is None or not set(diagnostics) <= set(NIS_DIAGNOSTICS)):
+        reason = (f"diagnostics other than {', '.join(NIS_DIAGNOSTICS)} are computed on the NumPy path only (asked: "
+                  f"{'all' if diagnostics is None else ', '.join(sorted(set(diagnostics) - set(NIS_DIAGNOSTICS)))})")
     if reason is None and not numba_available():
         reason = "numba is not installed (pip install numba==0.68.1)"
+    return reason
+
+
+def select_backend(est: Any, backend: str | None, diagnostics: set | None = frozenset()) -> str:
+    """The backend that runs ``est.estimate``: "numpy" or "numba" (see the module docstring).
+
+    ``backend`` None: :func:`default_backend`. ``diagnostics`` is what
+    :func:`hinfnav.estimators.base.history_keys` returns (None: all). Raises
+    InputError naming ``backend`` when "numba" is asked for and no kernel fits.
+    """
+    backend = default_backend() if backend is None else as_choice("backend", backend, BACKENDS)
+    if backend == "numpy":
+        return "numpy"
+    reason = why_numpy(est, diagnostics)
     if reason is None:
         return "numba"
     if backend == "auto":
+        if _LOG.isEnabledFor(logging.INFO):
+            _LOG.info("filter %r runs on the NumPy path: %s", getattr(est, "name", "?"), reason)
         return "numpy"
     raise InputError(f"backend='numba' is not available for filter {est.name!r}: {reason}; use backend='numpy' "
                      "or 'auto'")
@@ -162,8 +224,14 @@ def _per_run(value, runs):
 
 
 def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: np.ndarray | None,
-                 keep_covariance: bool | str) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """``(xhat, P history)`` of ``est`` on checked inputs by its kernel, or ``(None, None)`` to fall back.
+                 keep_covariance: bool | str, diagnostics: set = frozenset()
+                 ) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
+    """``(xhat, P history, diagnostics)`` of ``est`` on checked inputs by its kernel, or ``(None, None, {})`` to
+    fall back.
+
+    ``diagnostics``: names among :data:`~.compiled_diagnostics.NIS_DIAGNOSTICS`
+    (computed from the kernel's histories by
+    :func:`~.compiled_diagnostics.nis_diagnostics`).
 
     ``y`` (runs, n_samples, m), ``u`` (runs, n_samples, n_input) and ``xhat0``
     as :func:`~hinfnav.estimators.base.check_estimator_inputs` returns them.
@@ -175,25 +243,35 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     kern = _kernels()
     kind = _kind(est)
     runs, steps, _ = y.shape
+    if kind == "lti":
+        xhat = np.empty((runs, steps, est.n_state))
+        use_input = bool(est.uses_input)
+        M = _float(est.input_correction) if use_input else np.zeros((est.n_state, 1))
+        H = _float(est.measurement.H) if est.missing == "skip" else np.zeros((y.shape[2], est.n_state))
+        ok = kern.lti_batch(_float(est.A_effective), _float(est.B_F), _float(est.C_F), M, H,
+                            _float(est.start(xhat0, None, 1).x[0]), _float(y), _float(u) if use_input else
+                            np.zeros((runs, steps, 1)), use_input, est.missing == "skip", xhat)
+        return (xhat, None, {}) if ok else (None, None, {})
     state = est.start(xhat0, P0, runs)  # the filter's own checks of P0 and its per-run parameters
     x0 = _float(state.x[0])
     P_start = _float(state.P if state.P.ndim == 2 else state.P[0])
     y = _float(y)
     u = _float(u) if u.shape[2] else np.zeros((runs, steps, 1))
-    keep = {False: 0, "diagonal": 1, True: 2}[keep_covariance]
+    keep = want_keep = {False: 0, "diagonal": 1, True: 2}[keep_covariance]
+    if diagnostics and kind != "recursive_hinf":
+        keep = 2  # the posterior covariances give S
     use_input = bool(est.uses_input)
     H = _float(est.measurement.H)
-    shared = False
+    shared = strong = False
     if kind in ("kalman", "augmented"):
-        names = _mro_names(est)
-        strong, huber = "StrongTracking" in names, "HuberCorrection" in names
+        strong, huber = bool(getattr(est, "strong_tracking", False)), bool(getattr(est, "huber_correction", False))
         shared = bool(est.shares_covariance)
         if kind == "kalman":
             F, Qd, n_rep = est.F, est.Q, est.n_state
             G = est.Gamma if use_input else np.zeros((est.n_state, u.shape[2]))
         else:
             F, Qd, n_rep, use_input = est.Phi_a, est.Qd, est.n_state, False
-            H = _float(est._H)
+            H = _float(est.H_augmented)
             G = np.zeros((F.shape[0], u.shape[2]))
         n = F.shape[0]
     elif kind == "sigma_point":
@@ -204,13 +282,16 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
         shared = True
     if G is None or G.shape[1] != u.shape[2]:
         G = np.zeros((n, u.shape[2]))
+    n_out = n_rep
+    if diagnostics:
+        n_rep = n  # the whole (augmented) state: the priors follow from it
     xhat = np.empty((runs, steps, n_rep))
     p_runs = 1 if shared else runs
     Pdiag = np.empty((p_runs, steps, n_rep)) if keep == 1 else np.empty((1, 1, 1))
     Pfull = np.empty((p_runs, steps, n_rep, n_rep)) if keep == 2 else np.empty((1, 1, 1, 1))
     F, G = _float(F), _float(G)
     if kind in ("kalman", "augmented"):
-        LRi = _float(est._LRi) if huber else np.eye(H.shape[0])
+        LRi = _float(est.whitening_matrix) if huber else np.eye(H.shape[0])
         rho = _per_run(est.rho, runs) if strong else np.ones(runs)
         beta = _per_run(est.beta, runs) if strong else np.ones(runs)
         a = _float(est.a) if strong else np.ones(n)
@@ -224,13 +305,29 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
                                     est.output == "filtered", _float(est.Wm), _float(est.Wc), float(est.scale),
                                     est.rule == "unscented", keep, xhat, Pdiag, Pfull)
     else:
-        ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est._G), _float(est._HtRi), P_start, x0, y, u,
+        ok = kern.recursive_hinf_batch(F, G, H, _float(est.Q), _float(est.G_theta), _float(est.HtRi), P_start, x0, y, u,
                                        use_input, _kernel_steady_tol(est), keep, xhat, Pdiag, Pfull)
     if not ok:
-        return None, None
+        return None, None, {}
+    diag = {}
+    if diagnostics:
+        filtered = kind != "recursive_hinf" and est.output == "filtered"
+        Qd_used = _float(est.Qd if kind == "augmented" else est.Q)
+        diag = nis_diagnostics(est, diagnostics, F=F, G=G, H=H, Qd=Qd_used, R=_float(est.R), P_start=P_start, x0=x0,
+                               y=y, u=u, use_input=use_input, filtered=filtered, xhat=xhat,
+                               P=Pfull if keep == 2 else None, strong=kind != "recursive_hinf" and strong,
+                               with_S=kind != "recursive_hinf")
+        xhat = np.ascontiguousarray(xhat[:, :, :n_out])
+        if want_keep == 0:
+            Pfull = None
+        elif want_keep == 1:
+            Pdiag = np.ascontiguousarray(np.diagonal(Pfull, axis1=-2, axis2=-1)[:, :, :n_out])
+        elif keep == 2 and n_out < n_rep:
+            Pfull = np.ascontiguousarray(Pfull[:, :, :n_out, :n_out])
+        keep = want_keep
     P_hist = {0: None, 1: Pdiag, 2: Pfull}[keep]
     if P_hist is not None and shared:
         P_hist = P_hist[0]
         P_hist.setflags(write=False)
         P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
-    return xhat, P_hist
+    return xhat, P_hist, diag

@@ -16,7 +16,7 @@ this module, delete the kernels' cache (``__pycache__/compiled_*.nbi``/``.nbc`` 
 import numpy as np
 from numba import njit
 
-from .compiled_linalg import (chol, chol_solve, chol_to, inv_to, lin, maxabs, mm_to, mmt_to, mv, mv_to, spd_inv, sym,
+from .compiled_linalg import (chol, chol_solve, chol_to, inv_to, lin, maxabs, mm_to, mmt_to, mv, mv_to, sym,
                               tri_inv)
 
 __all__ = ["huber_to"]
@@ -146,7 +146,9 @@ def _minimise(M, yv, x, gamma, tol, max_iter):
         for b in range(len(_BETAS)):
             f = 1.0
             for _t in range(_N_BACKTRACK):
-                trial = lin(1.0 - f, x, f, cands[b])
+                trial = np.empty(n)
+                for i in range(n):  # x + (cand − x) f, as huber_regression.minimise
+                    trial[i] = x[i] + (cands[b, i] - x[i]) * f
                 cost = _huber_cost(_residual(M, trial, yv), gamma)
                 if cost < best_cost:
                     best, best_cost = trial, cost
@@ -194,65 +196,182 @@ def _huber_general(P, A, e, dx, gamma, tol, max_iter):
     yv[:m] = e
     dx = _minimise(M, yv, dx, gamma, tol, max_iter)
     w = _psi(_residual(M, dx, yv), gamma)
-    Pp, ok = spd_inv(_normal(M, w))
+    Pp, ok = _covariance(_normal(M, w))
     return dx, Pp, ok
 
 
 @njit(cache=True, error_model="numpy")
-def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx, LP, ATc, wm, wmm, wnm):
-    """The first Newton point in the measurement space (huber.py's ``_minimise_measurement_space``).
+def _covariance(A):
+    """``(A⁻¹, ok)`` by the Jacobi-scaled Cholesky factor, symmetrised (huber_regression.covariance)."""
+    n = A.shape[0]
+    s = np.empty(n)
+    for i in range(n):
+        d = A[i, i]
+        if not (np.isfinite(d) and d > 0.0):
+            return A, False
+        s[i] = 1.0 / np.sqrt(d)
+    As = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            As[i, j] = A[i, j] * s[i] * s[j]
+    L, ok = chol(As)
+    if not ok:
+        return A, False
+    Li = tri_inv(L)
+    P = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            t = 0.0
+            for k in range(n):
+                t += Li[k, i] * Li[k, j]
+            P[i, j] = t * s[i] * s[j]
+    sym(P)
+    return P, True
 
-    From the Kalman point c, the Newton point of the current split of the
-    measurement rows with every prior row quadratic,
-    ``c − (g − E T⁻¹ E C g)`` (``g = c + ρ'(C c − e)``, ``E`` = 1 on the rows
-    within gamma and 0 beyond, ``T = I + E C E``); when it reproduces the split
-    and keeps every prior row ``L_Pᵀ Aᵀ c`` within gamma it is the minimiser:
-    ``δx = P Aᵀ c`` and ``P⁺ = P − U (E_w C E_w + I)⁻¹ Uᵀ`` (``U = P Aᵀ E_w``,
-    ``E_w = diag(√ψ)``) are written and True returned; otherwise False.
-    Scratch (no allocation): LP (n, n), ATc (n), wm (8, m), wmm (3, m, m), wnm (2, n, m).
+
+@njit(cache=True, error_model="numpy")
+def _weighted(C, b, d):
+    """huber.py's ``_weighted``: ``(b − E T⁻¹ E C b, ok)``, ``E = diag(√d)``, ``T = I + E C E``."""
+    m = C.shape[0]
+    E = np.sqrt(d)
+    T = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            T[i, j] = E[i] * C[i, j] * E[j] + (1.0 if i == j else 0.0)
+    Ti = np.empty((m, m))
+    if not inv_to(T, np.zeros((m, m)), Ti):
+        return b.copy(), False
+    Cb = mv(C, b)
+    for i in range(m):
+        Cb[i] *= E[i]
+    w = mv(Ti, Cb)
+    out = np.empty(m)
+    for i in range(m):
+        out[i] = b[i] - E[i] * w[i]
+    return out, True
+
+
+@njit(cache=True, error_model="numpy")
+def _mspace(C, e, Bm, c, gamma, tol, max_iter):
+    """huber.py's ``_minimise_measurement_space`` for one run: ``(c, iterations, left, ok)``.
+
+    ``Bm = L_Pᵀ Aᵀ`` (n, m) maps c to the whitened prior residuals. Each
+    iteration: the Newton points of the current split (weights 1 within gamma,
+    β ψ beyond, β in BETAS); the first, if it reproduces the split with every
+    prior row within gamma, ends it; else, if a prior row is beyond gamma at
+    the current point, the run is ``left`` to the whole regression; else the
+    cheapest of the IRLS step and the backtracked Newton steps is taken (the
+    same candidates in the same order as the NumPy reference, so an
+    unconverged iteration stops at the same point).
+    """
+    m = C.shape[0]
+    n = Bm.shape[0]
+    slack = 1e-12 * gamma
+    c = c.copy()
+    nb = len(_BETAS)
+    cands = np.empty((nb, m))
+    d = np.empty(m)
+    grad = np.empty(m)
+    its = 0
+    for _ in range(max_iter):
+        zm = _residual(C, c, e)
+        zp = mv(Bm, c)
+        psi = _psi(zm, gamma)
+        for i in range(m):
+            grad[i] = c[i] + (zm[i] if abs(zm[i]) <= gamma else gamma * np.sign(zm[i]))
+        for b in range(nb):
+            for i in range(m):
+                d[i] = 1.0 if abs(zm[i]) <= gamma else _BETAS[b] * psi[i]
+            w, ok = _weighted(C, grad, d)
+            if not ok:
+                return c, its, False, False
+            for i in range(m):
+                cands[b, i] = c[i] - w[i]
+        zc = _residual(C, cands[0], e)
+        zpc = mv(Bm, cands[0])
+        exact = True
+        for i in range(m):
+            if abs(zm[i]) <= gamma:
+                if not abs(zc[i]) <= gamma + slack:
+                    exact = False
+            elif not np.sign(zm[i]) * zc[i] >= gamma - slack:
+                exact = False
+        for i in range(n):
+            if not abs(zpc[i]) <= gamma + slack:
+                exact = False
+        if exact:
+            return cands[0].copy(), its + 1, False, True
+        for i in range(n):
+            if abs(zp[i]) > gamma:
+                return c, its, True, True
+        pe = np.empty(m)
+        for i in range(m):
+            pe[i] = psi[i] * e[i]
+        cI, ok = _weighted(C, pe, psi)
+        if not ok:
+            return c, its, False, False
+        dc = lin(1.0, cI, -1.0, c)
+        step = max(maxabs(mv(C, dc)), maxabs(mv(Bm, dc)))
+        best = cI
+        best_cost = _huber_cost(_residual(C, cI, e), gamma) + _huber_cost(mv(Bm, cI), gamma)
+        for b in range(nb):
+            f = 1.0
+            for _t in range(_N_BACKTRACK):
+                trial = np.empty(m)
+                for i in range(m):
+                    trial[i] = c[i] + (cands[b, i] - c[i]) * f
+                cost = _huber_cost(_residual(C, trial, e), gamma) + _huber_cost(mv(Bm, trial), gamma)
+                if cost < best_cost:
+                    best, best_cost = trial, cost
+                f *= 0.5
+        c = best
+        its += 1
+        if step <= tol:
+            break
+    return c, its, False, True
+
+
+@njit(cache=True, error_model="numpy")
+def _huber_out(P, A, PAT, C, e, c, gamma, tol, max_iter, Pp, dx, LP, wm, wmm, wnm):
+    """huber_correct's branch for a run whose Kalman point has a whitened residual beyond gamma.
+
+    The iterations in the measurement space (:func:`_mspace`); at their point
+    ``δx = P Aᵀ c`` and ``P⁺ = P − U (E C E + I)⁻¹ Uᵀ`` (``U = P Aᵀ E``,
+    ``E = diag(√ψ)`` of the measurement rows); when the run was left to the
+    whole regression (a prior row beyond gamma) or a prior row's weight is
+    below 1 there, the whole regression from that point with the iterations
+    left (:func:`_huber_general`).
     """
     m = C.shape[0]
     n = P.shape[0]
-    slack = 1e-12 * gamma
-    zm, grad, E, Cg, w, cand, zc = wm[0], wm[1], wm[2], wm[3], wm[4], wm[5], wm[6]
-    T, Lt, Ti = wmm[0], wmm[1], wmm[2]
-    U, UTi = wnm[0], wnm[1]
-    for i in range(m):
-        zm[i] = Cc[i] - e[i]
-        q = abs(zm[i]) <= gamma
-        grad[i] = c[i] + (zm[i] if q else gamma * np.sign(zm[i]))
-        E[i] = 1.0 if q else 0.0
-    if not _inv_eye_plus_scaled(C, E, T, Lt, Ti):
-        return False
-    mv_to(C, grad, Cg)
-    for i in range(m):
-        Cg[i] *= E[i]
-    mv_to(Ti, Cg, w)
-    for i in range(m):
-        cand[i] = c[i] - (grad[i] - E[i] * w[i])
-    mv_to(C, cand, zc)
-    for i in range(m):
-        zc[i] -= e[i]
-        if E[i] == 1.0:
-            if not abs(zc[i]) <= gamma + slack:
-                return False
-        elif not np.sign(zm[i]) * zc[i] >= gamma - slack:
-            return False
     if not chol_to(P, LP):
         return False
+    Bm = np.zeros((n, m))  # L_Pᵀ Aᵀ
     for j in range(n):
-        ATc[j] = 0.0
-    for i in range(m):
-        for j in range(n):
-            ATc[j] += A[i, j] * cand[i]
-    for j in range(n):  # prior rows L_Pᵀ Aᵀ c: beyond gamma (weight < 1), the whole regression decides
-        s = 0.0
-        for k in range(j, n):
-            s += LP[k, j] * ATc[k]
-        if not abs(s) <= gamma:
-            return False
-    for i in range(m):  # E_w = diag(√ψ(z_c)) (_psi's weights)
-        a = abs(zc[i])
+        for i in range(m):
+            s = 0.0
+            for k in range(j, n):
+                s += LP[k, j] * A[i, k]
+            Bm[j, i] = s
+    co, its, left, ok = _mspace(C, e, Bm, c, gamma, tol, max_iter)
+    if not ok:
+        return False
+    mv_to(PAT, co, dx)
+    zp = mv(Bm, co)
+    general = left
+    for i in range(n):
+        if abs(zp[i]) > gamma:
+            general = True
+    if general:
+        budget = max_iter - its if left else 0
+        dx2, Pp2, ok = _huber_general(P, A, e, dx.copy(), gamma, tol, budget)
+        Pp[:] = Pp2
+        dx[:] = dx2
+        return ok
+    E, T, Lt, Ti, U, UTi = wm[0], wmm[0], wmm[1], wmm[2], wnm[0], wnm[1]
+    zm = _residual(C, co, e)
+    for i in range(m):  # E = diag(√ψ(z_m)) (_psi's weights)
+        a = abs(zm[i])
         E[i] = np.sqrt(1.0 if a <= gamma else gamma / max(a, gamma))
     if not _inv_eye_plus_scaled(C, E, T, Lt, Ti):
         return False
@@ -261,7 +380,6 @@ def _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx, LP, ATc, wm, wmm, wnm
             U[i, j] = PAT[i, j] * E[j]
     mm_to(U, Ti, UTi)
     _minus_outer(P, UTi, U, Pp)
-    mv_to(PAT, cand, dx)
     return True
 
 
@@ -308,13 +426,8 @@ def huber_to(P, A, LRi, nu, gamma, tol, max_iter, e, PAT, C, Lm, Si, c, Cc, KW, 
             z[i] = s / LP[i, i]
             if not abs(z[i]) <= gamma:
                 inside = False
-    if not inside and _huber_newton_m(P, A, PAT, C, e, c, Cc, gamma, Pp, dx, LP, z, wm, wmm, wnm):
-        return True
     if not inside:
-        dx2, Pp2, ok = _huber_general(P, A, e, dx.copy(), gamma, tol, max_iter)
-        Pp[:] = Pp2
-        dx[:] = dx2
-        return ok
+        return _huber_out(P, A, PAT, C, e, c, gamma, tol, max_iter, Pp, dx, LP, wm, wmm, wnm)
     mm_to(PAT, Si, KW)
     _minus_outer(P, KW, PAT, Pp)
     return True

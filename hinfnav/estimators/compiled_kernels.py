@@ -40,7 +40,7 @@ from .compiled_lanes import LANES, kalman_lanes, shared_means
 from .compiled_linalg import (chol, chol_solve, chol_to, eye_minus, finite, inv_to, lin, mm, mm_to, mmt, mmt_sym_to,
                               mmt_to, mv_to, sym)
 
-__all__ = ["kalman_batch", "sigma_point_batch", "recursive_hinf_batch"]
+__all__ = ["kalman_batch", "lti_batch", "sigma_point_batch", "recursive_hinf_batch"]
 
 
 # -- the Kalman core ----------------------------------------------------------------------
@@ -364,3 +364,52 @@ def recursive_hinf_batch(F, G, H, Q, Gm, HtRi, P0, x0, y, u, use_input, freeze, 
     # x⁺ = F x + F K (y − H x) + G u: the mean step with gain F K from x, then x = I·x⁺ + G u
     return shared_means(FK, np.zeros((steps, m)), np.zeros((steps, n)), F, G, H, x0, y, u, use_input, False, True, n,
                         xhat)
+
+
+# -- the LTI filter (12) ------------------------------------------------------------------
+
+@njit(cache=True, error_model="numpy")
+def lti_batch(A, B, C, M, H, xf0, y, u, use_input, skip, xhat):
+    """The fixed-gain filter (12) of :class:`~hinfnav.estimators.lti.LTIFilter`, every run and step; ok.
+
+    ``x̂ₖ = C_F x_fₖ`` (reported), ``x_fₖ₊₁ = A x_fₖ + B_F yₖ (+ M uₖ)`` with A the
+    filter's effective matrix (``A_F − M K C_F`` with the known input) and
+    ``M = C_F⁻¹ G``. With ``skip`` a NaN channel of yₖ is replaced by the
+    reading the filter predicts, ``(H x̂ₖ)ᵢ`` (a linear measurement).
+    """
+    runs, steps, m = y.shape
+    n = A.shape[0]
+    x, xn, yk = np.empty(n), np.empty(n), np.empty(m)
+    for r in range(runs):
+        x[:] = xf0
+        for k in range(steps):
+            for i in range(n):
+                s = 0.0
+                for j in range(n):
+                    s += C[i, j] * x[j]
+                xhat[r, k, i] = s
+            if k == steps - 1:
+                break
+            for i in range(m):
+                v = y[r, k, i]
+                if skip and np.isnan(v):
+                    v = 0.0
+                    for j in range(n):
+                        v += H[i, j] * xhat[r, k, j]
+                yk[i] = v
+            for i in range(n):
+                s = 0.0
+                for j in range(n):
+                    s += A[i, j] * x[j]
+                d = 0.0
+                for j in range(m):
+                    d += B[i, j] * yk[j]
+                if use_input:
+                    for j in range(M.shape[1]):
+                        d += M[i, j] * u[r, k, j]
+                xn[i] = s + d
+            x[:] = xn
+            for i in range(n):
+                if not np.isfinite(x[i]):
+                    return False
+    return True

@@ -60,6 +60,8 @@ class HuberCorrection:
     """
 
     data_dependent_covariance = True
+    #: The correction is Huber's M-estimation (read by the compiled kernels).
+    huber_correction = True
 
     def __init__(self, *args: Any, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -67,6 +69,12 @@ class HuberCorrection:
         self.tol = as_positive("tol", tol)
         self.max_iter = as_int_at_least("max_iter", max_iter, 1)
         self._LRi = None if self.R is None else whitening(self.R)  # constant R: whitened once
+
+    @property
+    def whitening_matrix(self) -> np.ndarray | None:
+        """``L_R⁻¹`` of the constant R (:func:`~hinfnav.estimators.huber.whitening`), None when R depends on the
+        reading."""
+        return self._LRi
 
     @property
     def shares_covariance(self) -> bool:
@@ -110,6 +118,9 @@ class HuberFilter(HuberCorrection, ExtendedKalmanFilter):
 
     name = "hbf"
 
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "kalman"
+
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
                  R: ArrayLike | None = None, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50,
                  uses_input: bool = False, output: str = "filtered", name: str | None = None,
@@ -142,3 +153,6 @@ class HuberStrongTrackingEKF(HuberCorrection, StrongTrackingEKF):
     """
 
     name = "huber_stekf"
+
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "kalman"

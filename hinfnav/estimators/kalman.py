@@ -287,6 +287,9 @@ class ExtendedKalmanFilter(KalmanCore):
     name = "ekf"
     symmetric_posterior = False
 
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "kalman"
+
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
                  R: ArrayLike | None = None, uses_input: bool = False, output: str = "filtered", name: str | None = None,
                  missing: str = "refuse") -> None:
@@ -388,6 +391,9 @@ class StrongTrackingEKF(StrongTracking, ExtendedKalmanFilter):
     """
 
     name = "stekf"
+
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "kalman"
 
 
 class RateAdaptiveEKF(RateAdaptive, ExtendedKalmanFilter):

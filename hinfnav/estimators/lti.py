@@ -60,9 +60,14 @@ class LTIFilter(Estimator):
     A predictor: the estimate at t_k uses y(0) … y(k−1), as (12) prescribes
     (``update`` stores y_k and reports ``C_F x_f(k)``). The initial filter
     state is ``x_f(0) = C_F⁻¹ x̂(0)`` so that the first estimate is x̂(0).
-    The gains are fixed: the batch ``estimate`` is the base class's one loop
-    over these hooks (no separate batch recursion).
+    The gains are fixed: the batch ``estimate`` runs the compiled kernel
+    (:func:`hinfnav.estimators.compiled_kernels.lti_batch`, the same
+    recursion) by default, the base class's loop over these hooks with
+    ``backend="numpy"``. It reports no covariance and no diagnostics.
     """
+
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "lti"
 
     def __init__(self, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, system: LinearSystem | DynamicsModel, measurement: MeasurementModel,
                  *, name: str = "lti", input_matrix: ArrayLike | None = None, K: ArrayLike | None = None, missing: str = "refuse") -> None:
@@ -94,6 +99,16 @@ class LTIFilter(Estimator):
                 f"{what} must be Schur stable (spectral radius < 1); it is {rho:.6g}: the filter's estimates "
                 "would diverge whatever the data (check A_F, or the T and K it was designed for)"
             )
+
+    @property
+    def A_effective(self) -> np.ndarray:
+        """The matrix of the recursion: ``A_F``, or ``A_F − C_F⁻¹ G K C_F`` with the known input."""
+        return self._A_eff
+
+    @property
+    def input_correction(self) -> np.ndarray | None:
+        """``C_F⁻¹ G`` (n, m_u) of the known-input correction, None without it."""
+        return self._M
 
     @property
     def n_input(self) -> int:

@@ -126,6 +126,9 @@ class RecursiveHInfinityFilter(Estimator):
 
     name = "recursive_hinf"
 
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "recursive_hinf"
+
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, theta: float, P0: ArrayLike,
                  Q: ArrayLike | None = None, R: ArrayLike | None = None, L: ArrayLike | None = None, S: ArrayLike | None = None, uses_input: bool = True,
                  on_violation: str = "raise", steady_tol: float | None = STEADY_TOL, name: str | None = None,
@@ -154,6 +157,16 @@ class RecursiveHInfinityFilter(Estimator):
         self.Sbar = self.L.T @ self.S @ self.L
         self._G = 0.5 * (W + W.T) - self.theta * 0.5 * (self.Sbar + self.Sbar.T)
         self._theta_max = None
+
+    @property
+    def HtRi(self) -> np.ndarray:
+        """``Hᵀ R⁻¹`` (n, m)."""
+        return self._HtRi
+
+    @property
+    def G_theta(self) -> np.ndarray:
+        """``Hᵀ R⁻¹ H − θ S̄`` (symmetrised), the matrix of the recursion's ``N = I + Cᵀ G C``."""
+        return self._G
 
     # -- the data-independent recursion --------------------------------------------
 

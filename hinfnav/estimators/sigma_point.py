@@ -130,6 +130,9 @@ class SigmaPointFilter(GateOption, Estimator):
 
     name = "ukf"
 
+    #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
+    compiled_kernel = "sigma_point"
+
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
                  R: ArrayLike | None = None, rule: str = "unscented", alpha: float = 1.0, beta: float = 2.0, kappa: float = 0.0,
                  uses_input: bool = False, output: str = "filtered", name: str | None = None,

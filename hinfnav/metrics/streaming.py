@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..core.exceptions import InputError
+from ..estimators.compiled import use_backend
 from ..sim.engine import resolve_estimator, run_monte_carlo
 from .accumulator import StatisticsSink, WindowStatistics
 from .consistency import NIS_KEYS, warn_if_diverged
@@ -73,12 +74,13 @@ class MonteCarloStatistics:
 def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | SynthesisResult, *, windows: Mapping[str, Sequence[float]],
                            runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, noise: str | NoiseModel = "gaussian",
                            measurement_noise: str | NoiseModel | None = None, batch_size: int = 100, progress: bool = False,
-                           tol: ArrayLike | None = None, **conditions: Any) -> MonteCarloStatistics:
+                           tol: ArrayLike | None = None, backend: str | None = None,
+                           **conditions: Any) -> MonteCarloStatistics:
     """Run Monte Carlo batches and keep running statistics only.
 
     Parameters
     ----------
-    scenario, estimator, runs, seed, noise, measurement_noise, batch_size, progress, **conditions
+    scenario, estimator, runs, seed, noise, measurement_noise, batch_size, progress, backend, **conditions
         As in :func:`hinfnav.simulate`.
     windows : dict
         Name → (start, end) in s.
@@ -93,9 +95,10 @@ def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | Synthesis
     """
     sink = StatisticsSink(windows, runs, scenario.xhat0, tol)
     est = resolve_estimator(scenario, estimator)
-    acc = run_monte_carlo(scenario, {est.name: est}, sink=sink, runs=runs, seed=seed, batch_size=batch_size,
-                          noise=noise, measurement_noise=measurement_noise, keep_covariance=True,
-                          diagnostics=NIS_KEYS, progress=progress, **conditions)[est.name]
+    with use_backend(backend):
+        acc = run_monte_carlo(scenario, {est.name: est}, sink=sink, runs=runs, seed=seed, batch_size=batch_size,
+                              noise=noise, measurement_noise=measurement_noise, keep_covariance=True,
+                              diagnostics=NIS_KEYS, progress=progress, **conditions)[est.name]
     if acc.nonfinite:
         raise InputError(f"the estimator {est.name!r} produced non-finite estimates in {acc.nonfinite} of {runs} runs "
                          "(it diverged); no statistics can be formed")

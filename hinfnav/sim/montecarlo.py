@@ -24,6 +24,7 @@ from ..core.exceptions import InputError
 from ..core.protocols import OwnTruthScenario
 from ..core.validation import as_int_at_least
 from ..estimators.base import Estimator
+from ..estimators.compiled import use_backend
 from .engine import (
     HistorySink,
     check_measurement_match,
@@ -124,7 +125,7 @@ def check_history_memory(scenario: Any, runs: int, *, fraction: float = 0.8, **c
 def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
              measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, batch_size: int = 100,
              progress: bool = False, keep_covariance: bool | str = True, diagnostics: bool | Sequence[str] = NIS_KEYS,
-             **conditions: Any) -> SimulationResult:
+             backend: str | None = None, **conditions: Any) -> SimulationResult:
     """Simulate a scenario's truth (linear or nonlinear) and run an estimator on it, over Monte Carlo runs.
 
     Parameters
@@ -146,6 +147,9 @@ def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noi
         Keep the covariance history (True), its diagonal, or none.
     diagnostics : bool or iterable of str
         The estimator's diagnostics histories to keep (default: the innovation and its covariance S).
+    backend : {"auto", "numpy", "numba"}, optional
+        How the estimator runs (:meth:`~hinfnav.estimators.base.Estimator.estimate`; default
+        :func:`~hinfnav.estimators.compiled.default_backend`, "auto").
     **conditions
         The scenario's conditions (``maneuver``, ``delta``, ``discretization``
         for Sun et al. 2011).
@@ -165,7 +169,8 @@ def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noi
     if not isinstance(scenario, OwnTruthScenario):
         check_history_memory(scenario, runs, **conditions)
     estimator = resolve_estimator(scenario, estimator)
-    out = run_monte_carlo(scenario, {estimator.name: estimator}, sink=HistorySink(scenario.xhat0, runs), runs=runs,
-                          seed=seed, batch_size=batch_size, noise=noise, measurement_noise=measurement_noise,
-                          keep_covariance=keep_covariance, diagnostics=diagnostics, progress=progress, **conditions)
+    with use_backend(backend):
+        out = run_monte_carlo(scenario, {estimator.name: estimator}, sink=HistorySink(scenario.xhat0, runs), runs=runs,
+                              seed=seed, batch_size=batch_size, noise=noise, measurement_noise=measurement_noise,
+                              keep_covariance=keep_covariance, diagnostics=diagnostics, progress=progress, **conditions)
     return out[estimator.name]
