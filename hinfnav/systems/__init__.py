@@ -27,6 +27,7 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .continuous import ContinuousPolytope
 from .files import read_system_file
 from .planar import ConvertedRangeBearing, RangeBearing
 from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
@@ -36,6 +37,7 @@ from .state import StateSpec, chaser_state_spec
 from .uncertain import UncertainSystem
 
 __all__ = [
+    "ContinuousPolytope",
     "StateSpec",
     "chaser_state_spec",
     "LinearSystem",
