@@ -2,7 +2,7 @@
 
 A plant written in continuous time as a function of physical parameters
 ``p``, ``ẋ = A_c(p) x + B_c(p) w``, ``y = C(p) x + D(p) v``, ``z = L(p) x``,
-sampled at ``dt`` with a zero-order hold on w, is the discrete plant
+sampled at ``dt`` with a zero-order hold on w, is the discrete plant::
 
     A(p) = e^{A_c(p) dt},   B(p) = ∫₀^dt e^{A_c(p) s} ds B_c(p),   C, D, L unchanged
 
@@ -14,8 +14,8 @@ the sampled family with :func:`~hinfnav.systems.polytope_coverage`, and
 designs the certified discrete filter with
 :func:`~hinfnav.design.synthesize_polytopic`.
 
-What is covered, and what is not
---------------------------------
+**What is covered, and what is not.**
+
 * **Covered** (certified in float64): every discrete plant in the polytope
   (the union of the cells' hulls) — the filter's ℓ2 gain from the sampled
   ``(w_k, v_k)`` to the error ``z_k − ẑ_k`` is below ``gamma`` for every α

@@ -7,7 +7,7 @@ unit simplex Λ₂ (a *multi-simplex*, Oliveira & Peres). The data are then
 homogeneous polynomials of degree one in each αᵢ whose coefficients are the
 plants at the box corners: ``A(α) = Σ_c ∏ᵢ αᵢ,cᵢ A(θ_c)``. With the
 Lyapunov matrix ``P(α)`` homogeneous of degree g in each αᵢ, the bounded
-real lemma
+real lemma::
 
     T(α) = [[A(α)ᵀP(α) + P(α)A(α) + C(α)ᵀC(α), ⋆], [B(α)ᵀP(α) + D(α)ᵀC(α), D(α)ᵀD(α) − γ² I]] < 0
 
