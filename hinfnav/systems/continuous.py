@@ -70,5 +70,5 @@ class ContinuousPolytope:
         """Nominal matrices (dict of A, B, C, D, L) and vertices giving any of them that differ (as in the TOML)."""
         if not vertices:
             return cls((tuple(nominal[k] for k in MATRIX_KEYS),), ("nominal",))
-        return cls(tuple(tuple(v.get(k, nominal[k]) if v.get(k) is not None else nominal[k] for k in MATRIX_KEYS)
+        return cls(tuple(tuple(nominal[k] if v.get(k) is None else v[k] for k in MATRIX_KEYS)
                          for v in vertices))
