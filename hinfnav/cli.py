@@ -194,6 +194,13 @@ def _cmd_design_own(args):
         return
     if args.gamma is not None:
         raise InputError("--gamma applies to --objective h2 of the built-in scenario only")
+    if args.save:
+        from .systems.files import read_system_file
+
+        if read_system_file(args.system).dt == 0:
+            raise InputError("--save: a continuous-time design (dt = 0) cannot be saved yet: the design-file format "
+                             "and --recertify carry discrete-time certificates only (drop --save; the design is "
+                             "certified when it is printed)")
     result, rep = design_from_system_file(args.system, lyapunov=args.lyapunov, form=args.form,
                                           objective=args.objective, solver=args.solver)
     if args.save:

@@ -14,6 +14,8 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from .io import check_design_system, load_design, save_design, system_fingerprint
     from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
     from .compare import compare_uncertainty_models
+    from .continuous import ContinuousResult, design_continuous_system, synthesize_continuous_observer
+    from .discretised import DiscreteAtRate, design_discrete_at_rate
     from .explain import small_gain_number
     from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
     from .recertify import recertify
@@ -49,6 +51,11 @@ __all__ = [
     "design_from_system_file",
     "design_summary",
     "compare_uncertainty_models",
+    "ContinuousResult",
+    "design_continuous_system",
+    "synthesize_continuous_observer",
+    "DiscreteAtRate",
+    "design_discrete_at_rate",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__)

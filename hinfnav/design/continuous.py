@@ -17,12 +17,18 @@ continuous-time norm of ζ at sampled convex weights
 Not covered here: a discrete filter at a chosen rate (discretising the
 uncertain plant does not give a polytope in general: design on the discrete
 plant's polytope with :func:`hinfnav.systems.polytope_from_parameters` and
-measure its coverage instead), TOML files with ``dt = 0``.
+measure its coverage instead; :func:`hinfnav.design.discretised.design_discrete_at_rate`).
+
+From a TOML file with ``dt = 0``: :func:`design_continuous_system` (what
+``design --system FILE --form observer`` calls) returns a
+:class:`ContinuousResult`. Saving it (``--save``) is refused: the design-file
+format and ``--recertify`` carry discrete-time certificates only.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -32,9 +38,13 @@ from ..analysis.continuous import hinf_norm_continuous
 from ..analysis.marginal import read_part
 from ..core.exceptions import CertificationError, UnstablePlantError
 from ..lmi.continuous import certify_continuous, solve_continuous_observer
+from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import simplex_grid
 
-__all__ = ["synthesize_continuous_observer", "continuous_augmented"]
+__all__ = ["synthesize_continuous_observer", "continuous_augmented", "ContinuousResult", "design_continuous_system"]
+
+COVERS_CONTINUOUS = ("every α constant in time in the simplex (parameter-dependent Lyapunov function), "
+                     "continuous time")
 
 
 def continuous_augmented(vertex, B_F, T, nominal):
@@ -91,4 +101,39 @@ def synthesize_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], *, e
     if not max(norms) <= best["gamma"] * (1 + 1e-9):
         raise CertificationError(f"a sampled norm {max(norms):.8g} exceeds the certified γ {best['gamma']:.8g}")
     return dict(best, A_F=A0 + B_F @ C0, C_F=-L0, verified_norm=float(max(norms)), states=part.states,
-                attempts=tuple(log))
+                attempts=tuple(log), sample_norms=np.array(norms))
+
+
+@dataclass(frozen=True)
+class ContinuousResult:
+    """A certified continuous-time observer-form filter ``ẋ_f = A_F x_f + B_F y``, ``ẑ = C_F x_f``."""
+
+    A_F: np.ndarray
+    B_F: np.ndarray
+    C_F: np.ndarray
+    gamma: float
+    lmi_gamma: float
+    verified_norm: float
+    sample_norms: np.ndarray
+    system: ContinuousPolytope
+    solver: str
+    eps: float
+    witness: dict = field(repr=False)
+    form: str = "observer"
+    lyapunov: str = "parameter-dependent"
+    covers: str = COVERS_CONTINUOUS
+    objective: str = "hinf"
+
+
+def design_continuous_system(system: ContinuousPolytope, *, solver: str | None = None,
+                             eps: Sequence[float] = (0.01, 0.1, 1.0), points: int = 41) -> ContinuousResult:
+    """Observer-form design for a :class:`~hinfnav.systems.continuous.ContinuousPolytope` (see the module docstring).
+
+    ``sample_norms`` are the continuous-time norms of the error system at a
+    simplex grid of ``points`` per edge (one sample for a nominal plant).
+    """
+    solver = solver or "CLARABEL"
+    out = synthesize_continuous_observer(system.vertices, eps=eps, solver=solver, points=points)
+    return ContinuousResult(out["A_F"], out["B_F"], out["C_F"], float(out["gamma"]), float(out["lmi_gamma"]),
+                            float(out["verified_norm"]), np.asarray(out["sample_norms"]), system, solver,
+                            float(out["eps"]), out["witness"])

@@ -5,7 +5,10 @@ Nominal and norm-bounded systems with ``lyapunov="common"`` go to
 a norm-bounded system with ``lyapunov="parameter-dependent"`` is first
 written as the polytope of its sign vertices
 (:meth:`~hinfnav.systems.PolytopicSystem.from_norm_bounded`, F diagonal), and
-polytopes go to :func:`~hinfnav.design.synthesize_polytopic`.
+polytopes go to :func:`~hinfnav.design.synthesize_polytopic`. A
+continuous-time file (``dt = 0``) goes to
+:func:`~hinfnav.design.continuous.design_continuous_system` (observer form,
+parameter-dependent, H∞ only).
 """
 
 from __future__ import annotations
@@ -18,7 +21,10 @@ import numpy as np
 from ..io.provenance import provenance
 from ..core.validation import as_choice
 from ..systems.files import read_system_file
+from ..core.exceptions import InputError
+from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import PolytopicSystem
+from .continuous import ContinuousResult, design_continuous_system
 from .polytopic import COVERS, LYAPUNOV, PolytopicResult, synthesize_polytopic
 from .robust_hinf import synthesize
 
@@ -28,9 +34,9 @@ if TYPE_CHECKING:
 __all__ = ["design_from_system_file", "design_summary"]
 
 
-def design_summary(result: SynthesisResult | PolytopicResult) -> dict[str, Any]:
-    """JSON-ready summary of a certified design (either result type)."""
-    poly = isinstance(result, PolytopicResult)
+def design_summary(result: SynthesisResult | PolytopicResult | ContinuousResult) -> dict[str, Any]:
+    """JSON-ready summary of a certified design (any result type)."""
+    poly = isinstance(result, (PolytopicResult, ContinuousResult))
     system = result.system
     if poly:
         lyapunov, covers = result.lyapunov, result.covers
@@ -57,7 +63,7 @@ def design_summary(result: SynthesisResult | PolytopicResult) -> dict[str, Any]:
 
 def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | None = None, form: str = "general",
                             objective: str = "hinf", solver: str | None = None
-                            ) -> tuple[SynthesisResult | PolytopicResult, dict[str, Any]]:
+                            ) -> tuple[SynthesisResult | PolytopicResult | ContinuousResult, dict[str, Any]]:
     """Read ``path`` (:func:`~hinfnav.systems.read_system_file`) and design a certified H∞ filter.
 
     Parameters
@@ -81,6 +87,13 @@ def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | Non
         lyapunov = as_choice("lyapunov", lyapunov, LYAPUNOV)
     form = as_choice("form", form, ("general", "observer"))
     system = read_system_file(path)
+    if isinstance(system, ContinuousPolytope):
+        if form != "observer" or objective != "hinf" or lyapunov == "common":
+            raise InputError(f"{path}: dt = 0 (continuous time) designs the observer form, H∞, parameter-dependent "
+                             "only (pass --form observer; no --objective h2, no --lyapunov common); got "
+                             f"form {form!r}, objective {objective!r}, lyapunov {lyapunov!r}")
+        result = design_continuous_system(system, solver=solver)
+        return result, design_summary(result)
     if objective == "h2":  # H2: the extended LMIs (E2) on the polytope (one vertex when nominal)
         if not isinstance(system, PolytopicSystem):
             system = PolytopicSystem.from_norm_bounded(system)

@@ -28,6 +28,7 @@ from .measurements import (
     range_angles_jacobian,
     wrap_angle,
 )
+from .continuous import ContinuousPolytope
 from .files import read_system_file
 from .planar import ConvertedRangeBearing, RangeBearing
 from .polytopic import PolytopicSystem, simplex_grid, two_mass_spring
@@ -39,6 +40,7 @@ from .timed import TimedReadings, TimedSystem, merge_readings, read_timed_csv
 
 __all__ = [
     "ConvertedPosition",
+    "ContinuousPolytope",
     "StateSpec",
     "chaser_state_spec",
     "LinearSystem",

@@ -3,7 +3,7 @@
 Format (nested lists of numbers; ``x⁺ = A x + B w``, ``y = C x + D v``,
 ``z = L x``, w and v separate noise inputs as everywhere in hinfnav)::
 
-    dt = 0.1                       # sampling time, s
+    dt = 0.1                       # sampling time, s (dt = 0: continuous time, below)
     [nominal]
     A = [[1.0, 0.1], [0.0, 1.0]]
     B = [[0.005], [0.1]]
@@ -19,6 +19,11 @@ Format (nested lists of numbers; ``x⁺ = A x + B w``, ``y = C x + D v``,
     # cells = [[0, 1, 2, 3], [2, 3, 4, 5]]: the family is the union of the
     # hulls of these groups of vertices (0-based), not the hull of all
 
+``dt = 0`` reads the same tables as a continuous-time plant
+(``ẋ = A x + B w``): a :class:`~hinfnav.systems.continuous.ContinuousPolytope`
+(nominal, or ``kind = "polytope"`` without cells; norm-bounded uncertainty
+is refused: write its vertices ``A ± H E`` as a polytope).
+
 Every error names the key in the file.
 """
 
@@ -29,6 +34,7 @@ import os
 from ..core.exceptions import InputError
 from ..core.tomlfile import check_schema, read_toml
 from ..core.validation import as_matrix, as_positive
+from .continuous import ContinuousPolytope
 from .polytopic import MATRIX_KEYS, PolytopicSystem
 from .uncertain import UncertainSystem
 
@@ -63,13 +69,43 @@ def _matrix(where, table, key, required=True):
         raise InputError(f"{where}.{key}: {exc}") from None
 
 
-def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | PolytopicSystem:
+def _vertices(verts):
+    if not isinstance(verts, list) or not verts or not all(isinstance(v, dict) for v in verts):
+        raise InputError("[uncertainty] kind = 'polytope' needs 'vertices', an array of tables "
+                         "([[uncertainty.vertices]]) each with any of A, B, C, D, L")
+    for i, v in enumerate(verts):
+        bad = sorted(set(v) - set(MATRIX_KEYS))
+        if bad:
+            raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
+                             f"{', '.join(MATRIX_KEYS)}")
+    return [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
+
+
+def _continuous(mats, unc):
+    """``dt = 0``: a nominal plant or a polytope without cells, in continuous time."""
+    if unc is None:
+        return ContinuousPolytope.from_matrices(mats)
+    if not isinstance(unc, dict):
+        raise InputError("key 'uncertainty' must be a table [uncertainty]")
+    kind = unc.get("kind")
+    if kind != "polytope":
+        raise InputError(f"dt = 0 (continuous time): [uncertainty] kind must be \"polytope\"; got {kind!r} "
+                         "(norm-bounded uncertainty is not carried in continuous time: write the vertices "
+                         "A ± H E as a polytope)")
+    if "cells" in unc:
+        raise InputError("dt = 0 (continuous time): [uncertainty] key 'cells' is not supported in continuous time "
+                         "(the continuous design certifies the hull of all vertices)")
+    return ContinuousPolytope.from_matrices(mats, _vertices(unc.get("vertices")))
+
+
+def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | PolytopicSystem | ContinuousPolytope:
     """Read a system TOML file.
 
     Returns
     -------
-    UncertainSystem or PolytopicSystem
-        Nominal or norm-bounded (``UncertainSystem``), or a polytope.
+    UncertainSystem or PolytopicSystem or ContinuousPolytope
+        Nominal or norm-bounded (``UncertainSystem``), or a polytope;
+        ``dt = 0``: a continuous-time ``ContinuousPolytope``.
 
     Raises
     ------
@@ -83,9 +119,10 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
     if "dt" not in d:
-        raise InputError(f"{where}: missing key 'dt' (the sampling time, s)")
+        raise InputError(f"{where}: missing key 'dt' (the sampling time, s; 0 for continuous time)")
+    continuous = isinstance(d["dt"], (int, float)) and not isinstance(d["dt"], bool) and d["dt"] == 0
     try:
-        dt = as_positive("dt", d["dt"])
+        dt = 0.0 if continuous else as_positive("dt", d["dt"])
     except InputError as exc:
         raise InputError(f"{where}: key 'dt': {exc}") from None
     nom = d.get("nominal")
@@ -97,6 +134,8 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
     mats = {k: _matrix("[nominal]", nom, k) for k in MATRIX_KEYS}
     unc = d.get("uncertainty")
     try:
+        if continuous:
+            return _continuous(mats, unc)
         if unc is None:
             return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=dt)
         if not isinstance(unc, dict):
@@ -110,16 +149,7 @@ def read_system_file(path: str | os.PathLike[str]) -> UncertainSystem | Polytopi
             H, E = _matrix("[uncertainty]", unc, "H"), _matrix("[uncertainty]", unc, "E")
             return UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], H, E, dt=dt)
         if kind == "polytope":
-            verts = unc.get("vertices")
-            if not isinstance(verts, list) or not verts or not all(isinstance(v, dict) for v in verts):
-                raise InputError("[uncertainty] kind = 'polytope' needs 'vertices', an array of tables "
-                                 "([[uncertainty.vertices]]) each with any of A, B, C, D, L")
-            for i, v in enumerate(verts):
-                bad = sorted(set(v) - set(MATRIX_KEYS))
-                if bad:
-                    raise InputError(f"[uncertainty].vertices[{i}] has unknown key(s) {bad}; allowed: "
-                                     f"{', '.join(MATRIX_KEYS)}")
-            verts = [{k: _matrix(f"[uncertainty].vertices[{i}]", v, k) for k in v} for i, v in enumerate(verts)]
+            verts = _vertices(unc.get("vertices"))
             try:  # [nominal] must be a system on its own, even where every vertex replaces one of its matrices
                 UncertainSystem(mats["A"], mats["B"], mats["C"], mats["D"], mats["L"], dt=dt)
             except InputError as exc:
