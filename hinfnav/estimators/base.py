@@ -67,9 +67,10 @@ READING_LIMIT = 1e150
 #: :meth:`Estimator.estimate` that is neither among these nor reported by the filter is refused (issue 36: a
 #: misspelt name is never ignored); a known name a filter does not report is left out, so one list can be asked
 #: of several filters (the consistency statistics ask every filter for the NIS inputs, a study for the weights).
-KNOWN_DIAGNOSTICS = ("converged", "existence_margin", "existence_ok", "fading", "fading_c", "innovation",
-                     "innovation_covariance", "input_estimate", "input_rate", "iterations", "q_adapted", "saturated",
-                     "theta", "theta_alg2", "weights")
+KNOWN_DIAGNOSTICS = ("converged", "existence_margin", "existence_ok", "fading", "fading_c", "gate_count",
+                     "gate_distance", "gate_recovery", "gate_rejected", "innovation", "innovation_covariance",
+                     "input_estimate", "input_rate", "iterations", "noise_variance", "q_adapted", "saturated",
+                     "scale_measurement", "scale_prior", "theta", "theta_alg2", "vb_alpha", "vb_beta", "weights")
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
