@@ -39,7 +39,7 @@ from ..analysis.norms import h2_norm, hinf_norm
 from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
-from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
+from ..lmi.polytopic import extended_h2_matrices, extended_hinf_positive, hinf_gamma_index, polytopic_problem
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
@@ -157,7 +157,7 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
         if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape:
             raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the error system "
                              f"has {Abar.shape[0]} states")
-        N0 = extended_hinf_matrix(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
+        N0 = extended_hinf_positive(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
         g, _ = schur_gamma(-N0, hinf_gamma_index(Abar.shape[0], Bbar.shape[1]))
         per.append(g)
     return max(per), per
@@ -283,8 +283,9 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         alphas = simplex_grid(N, points=as_int_at_least("grid_points", grid_points, 1), n_random=0, seed=seed)
     verts = _vertex_tuples(system)
     log, statuses, best, seconds = [], [], None, 0.0
+    problem = polytopic_problem(verts, form, lyapunov, objective=objective)  # built once, re-solved below
     for slv in solvers:
-        sol = solve_polytopic_hinf(verts, form, lyapunov, slv, objective=objective)
+        sol = problem.solve(slv).as_dict()
         seconds += sol["seconds"]
         statuses.append(f"{slv} {sol['status']}")
         if "P" not in sol:
@@ -296,8 +297,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         log.append(f"{slv} minimize: status {sol['status']}, solver γ = {g_s:.10g}, certified γ = {cand[0]:.10g}")
         if not cand[-1] or cand[0] > g_s * (1 + 1e-3):
             for step in (1e-5, 1e-4, 1e-3, 1e-2, 1e-1):  # an interior point just above the solver's level certifies better
-                sol2 = solve_polytopic_hinf(verts, form, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2,
-                                            objective=objective)
+                sol2 = problem.solve(slv, (g_s * (1 + step)) ** 2).as_dict()
                 seconds += sol2["seconds"]
                 if "P" in sol2 and sol2["margin"] > 0:
                     c2 = _rebuild_and_certify(system, sol2, form, alphas, objective)

@@ -7,8 +7,6 @@ norm-bounded uncertainty for a given error system; the solution is checked by
 
 from __future__ import annotations
 
-import warnings
-
 import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,6 +14,7 @@ from numpy.typing import ArrayLike
 from ..analysis.certificates import LMICertificate, brl_blocks, schur_gamma
 from ..core.linalg import sym
 from .blocks import error_system_matrices
+from .solve import run_solver
 
 __all__ = ["robust_bounded_real_lmi"]
 
@@ -74,12 +73,9 @@ def _robust_brl_once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin):
     M = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, cp.bmat)
     size = M.shape[0]
     prob = cp.Problem(cp.Minimize(g), [0.5 * (M + M.T) << -margin * np.eye(size)])
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prob.solve(solver=solver)
-    except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: solver error ({exc})")
+    status, _, _ = run_solver(prob, solver)  # the solver's own tolerances (as this certificate always had)
+    if status.startswith("solver error"):
+        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: {status}")
     if P.value is None:
         return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: {prob.status}")
     Pv = sym(P.value)

@@ -20,7 +20,6 @@ Lyapunov matrix for the filter found.
 """
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -29,7 +28,7 @@ import numpy as np
 from ..analysis.certificates import schur_gamma
 from .blocks import error_system_matrices
 from .mixed_blocks import extended_h2_matrix
-from .solve import solver_kwargs
+from .solve import run_solver
 
 __all__ = ["H2Certificate", "robust_h2_bound"]
 
@@ -113,12 +112,9 @@ def _once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin, bound, accuracy):
     M = extended_h2_matrix(P, P, P @ Abar, Cbar, GH, Ebar, lam, 1.0, bmat=cp.bmat)
     cons = [0.5 * (M + M.T) << -margin * np.eye(M.shape[0]), P << bound * np.eye(N)]
     prob = cp.Problem(cp.Minimize(cp.trace(Bbar.T @ P @ Bbar)), cons)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-    except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-        return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: error ({exc})")
+    status, _, _ = run_solver(prob, solver, accuracy, retry=False)
+    if status.startswith("solver error"):
+        return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: {status}")
     if P.value is None:
         return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: {prob.status}")
     Pv = 0.5 * (P.value + P.value.T)

@@ -171,6 +171,14 @@ class Solution:
             return 0.0
         raise AttributeError(f"Solution has no value {name!r}")
 
+    def as_dict(self) -> dict:
+        """``status``, ``gamma2``, ``seconds``, and when solved ``margin`` and the values (a flat dict)."""
+        out = {"status": self.status, "gamma2": self.gamma2, "seconds": self.seconds}
+        if self.solved:
+            out["margin"] = self.margin
+            out.update(self.values)
+        return out
+
 
 #: Seconds one SCS solve may take (SCS's ``time_limit_secs``): SCS on LMI (20) otherwise runs for minutes
 #: (issue 22: ``design --solver SCS`` past 60 s); what it returns is certified independently all the same.
