@@ -384,7 +384,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     if "SCS" in solvers:
         warnings.warn(_SCS_WARNING, SolverAccuracyWarning, stacklevel=2)
     P = normalize(prepare(system, structure, state_scaling, form), options.normalize_above)
-    other = "none" if isinstance(state_scaling, str) and state_scaling == "balance" else "balance"
+    other = "units" if isinstance(state_scaling, str) and state_scaling == "balance" else "balance"
     preps = [P]
     for Q in (normalize(P, 0.0), normalize(prepare(system, structure, other, form), 0.0)):
         if all(_key(Q) != _key(R) for R in preps):
@@ -432,6 +432,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
         chk.variables.setdefault("lmi20_gamma", gamma_c)
         if form == "observer":
             gamma_full, lyap, lam_full = full_lyapunov_gamma(P, chk.A_F, chk.B_F, chk.C_F, _brl_solvers(solvers))
+            run.calls += len(_brl_solvers(solvers))  # one robust-BRL solve per solver
             run.log.append(f"observer filter, full Lyapunov matrix (robust BRL): certified γ = {gamma_full:.10g} "
                            f"(LMI (20), restricted Lyapunov matrix: {gamma_c:.10g})")
             if sampled <= gamma_full * (1.0 + 1e-9) and gamma_full < gamma_c:
@@ -470,6 +471,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
             form=form,
             sample_labels=() if sample_set is None else sample_set.labels,
             system=system,
+            solver_calls=run.calls,
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
         hint = infeasibility_hint(system.A, system.H, system.E, structure, form)

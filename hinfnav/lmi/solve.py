@@ -71,8 +71,12 @@ class SolverOptions:
         default chain was Clarabel then a CVXOPT polish, and CVXOPT's design
         won at every δ̄ of Sun et al. (2011)'s sweep, general and observer
         form, so CVXOPT alone returns the same filters at a third of the cost).
-    state_scaling : {"balance", "none"} or tuple of float
-        Diagonal state-coordinate scaling (rounded to powers of two).
+    state_scaling : {"balance", "units", "none"} or tuple of float
+        Diagonal state-coordinate scaling: ``"balance"`` (default) balances
+        A by powers of two; ``"units"`` first removes the state units
+        (:func:`hinfnav.lmi.conditioning.unit_scaling`: the design does not
+        depend on them; used by ``design --system``); a tuple gives the
+        factors (rounded to powers of two).
     normalize_above : float
         Scale of the noise block (B, D) or of the output block (L) above
         which it is normalised by a power of two before solving, and the
@@ -111,7 +115,9 @@ class SolverOptions:
         object.__setattr__(self, "max_bisection", as_int_at_least("max_bisection", self.max_bisection, 1))
         if not isinstance(self.polish, (bool, np.bool_)):
             raise InputError(f"polish must be True or False; got {self.polish!r}")
-        if not isinstance(self.state_scaling, str):
+        if isinstance(self.state_scaling, str):
+            as_choice("state_scaling", self.state_scaling, ("balance", "units", "none"))
+        else:
             object.__setattr__(self, "state_scaling", tuple(float(v) for v in np.ravel(self.state_scaling)))
         na = self.normalize_above
         if isinstance(na, bool) or not isinstance(na, numbers.Real) or math.isnan(na) or na < 0:
