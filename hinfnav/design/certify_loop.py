@@ -12,7 +12,7 @@ its solver's level, unless ``polish``):
 
 1. minimise the level with each solver, on the first variant;
 2. minimise with each solver on each further (rescaled) variant;
-3. tighten: feasibility just above the best solver level (1e-4 … 1 relative,
+3. tighten: feasibility just above each solver level, lowest first, until one certifies (1e-4 … 1 relative,
    the level a cvxpy Parameter, the problem not rebuilt);
 4. bisection on the level between the solver's level (a lower hint) and
    the best certified level (or the γ-free interior point, when the design
@@ -132,8 +132,8 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
         if method == "minimize" or (tight and polish):
             return loop
     # 3. tighten just above the best solver level
-    for v, slv, g, _status in sorted(mins, key=lambda m: m[2])[:1]:
-        if not g > 0:
+    for v, slv, g, _status in sorted(mins, key=lambda m: m[2]):
+        if not g > 0 or (loop.best() is not None and loop.best().how == "bisection"):
             continue
         for step in (1e-4, 1e-3, 1e-2, 1e-1, 1.0):
             level = g * (1.0 + step)

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg
+from scipy.sparse.csgraph import connected_components
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
@@ -190,8 +191,6 @@ def unit_scaling(A: ArrayLike, inputs: ArrayLike, outputs: ArrayLike, sweeps: in
                 change = max(change, abs(f - 1.0))
         if change < 1e-14:
             break
-    from scipy.sparse.csgraph import connected_components
-
     _, comp = connected_components(K + K.T > 0, directed=False)
     for k in np.unique(comp):
         idx = comp == k
