@@ -40,6 +40,7 @@ class Candidate:
     solver: str
     how: str
     variant: int = 0
+    level: float = float("nan")  # the solver's minimum the candidate descends from (NaN: bisection)
 
 
 @dataclass
@@ -65,7 +66,8 @@ def _level(sol):
 
 def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol: float = 1e-4,
                       max_bisection: int = 40, polish: bool = False, free: bool = False,
-                      done: Callable | None = None, method: str = "auto", loop: Loop | None = None) -> Loop:
+                      done: Callable | None = None, method: str = "auto", loop: Loop | None = None,
+                      steps: tuple = (1e-4, 1e-3, 1e-2, 1e-1, 1.0)) -> Loop:
     """Run the fallback order of this module (see there) and return the :class:`Loop`.
 
     Parameters
@@ -85,6 +87,8 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
         ``done(loop)``: stop early (e.g. the certificate is tight enough).
     method : {"auto", "minimize", "bisection"}
         ``"minimize"``: steps 1–2 only; ``"bisection"``: steps 3–4 only.
+    steps : tuple of float
+        Relative steps above a solver's level tried in step 3.
     """
     loop = loop or Loop()
     log = loop.log
@@ -95,8 +99,8 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
         loop.seconds += sol.seconds
         return sol, (certify(v, sol) if sol.solved else None)
 
-    def accept(chk, sol, slv, how, v):
-        loop.candidates.append(Candidate(chk, sol, slv, how, v))
+    def accept(chk, sol, slv, how, v, level=float("nan")):
+        loop.candidates.append(Candidate(chk, sol, slv, how, v, level))
 
     def finished():
         if done is not None and loop.candidates and done(loop):
@@ -123,7 +127,7 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
                 log.append(f"{slv} minimize{where}: status {sol.status}, solver γ = {g:.10g}, certified γ = "
                            f"{chk.gamma:.10g}: {chk.reason}")
                 if chk.ok:
-                    accept(chk, sol, slv, "minimize", v)
+                    accept(chk, sol, slv, "minimize", v, g)
                     tight = tight or chk.gamma <= g * (1.0 + rtol)
                 if loop.candidates and (tight or method == "minimize") and not polish:
                     return loop
@@ -135,14 +139,14 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
     for v, slv, g, _status in sorted(mins, key=lambda m: m[2]):
         if not g > 0 or (loop.best() is not None and loop.best().how == "bisection"):
             continue
-        for step in (1e-4, 1e-3, 1e-2, 1e-1, 1.0):
+        for step in steps:
             level = g * (1.0 + step)
             if loop.best() is not None and level >= loop.best().check.gamma:
                 break
             sol, chk = run(v, slv, level**2)
             if chk is not None and sol.margin > 0 and chk.ok:
                 log.append(f"{slv} feasibility at γ = {level:.10g}: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}")
-                accept(chk, sol, slv, "bisection", v)
+                accept(chk, sol, slv, "bisection", v, g)
                 break
             log.append(f"{slv} feasibility at γ = {level:.10g}: status {sol.status}, not certified")
             if not sol.solved and step >= 1e-3:
