@@ -151,7 +151,7 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
             log.append(f"{slv} feasibility at γ = {level:.10g}: status {sol.status}, not certified")
             if not sol.solved and step >= 1e-3:
                 break  # the solver gives no solution at all near its own optimum
-    if loop.candidates and (finished() or loop.best().check.gamma <= min(m[2] for m in mins) * (1 + 10 * rtol)):
+    if loop.candidates and (finished() or loop.best().check.gamma <= min((m[2] for m in mins), default=math.inf) * (1 + 10 * rtol)):
         return loop
     # 4. bisection on the level
     for slv in solvers:
