@@ -16,7 +16,7 @@ from hinfnav.analysis import error_system, error_system_matrices, hinf_norm_bise
 from hinfnav.core.exceptions import SynthesisError
 from hinfnav.design.mixed import front_gammas, knee_index, synthesize_mixed
 from hinfnav.lmi.blocks import gamma_index, lmi20_matrix
-from hinfnav.lmi.mixed_blocks import extended_h2_matrix, extended_hinf_matrix, h2_output_index, slack_products
+from hinfnav.lmi.mixed_blocks import extended_h2_matrix, robust_extended_hinf_negative, h2_output_index, slack_products
 from hinfnav.papers.sun2011 import (
     delta_samples,
     design_for_scenario,
@@ -62,7 +62,7 @@ def test_extended_blocks_with_g_equal_p_are_lmi20(random_uncertain):
     sp = slack_products(A, B, C, D, L, H, E, R, S, S, AbF, BbF, CbF)
     P = np.block([[R, S], [S, S]])
     np.testing.assert_array_equal(sp["G"], P)
-    M_ext = extended_hinf_matrix(P, sp["G"], sp["GA"], sp["GB"], sp["Cbar"], sp["GH"], sp["Ebar"], 0.7, 0.3)
+    M_ext = robust_extended_hinf_negative(P, sp["G"], sp["GA"], sp["GB"], sp["Cbar"], sp["GH"], sp["Ebar"], 0.7, 0.3)
     M_20 = lmi20_matrix(A, B, C, D, L, H, E, R, S, AbF, BbF, CbF, 0.7, 0.3)
     np.testing.assert_allclose(M_ext, M_20, rtol=0, atol=1e-12 * np.abs(M_20).max())
 
@@ -128,7 +128,7 @@ def test_certificates_hold_when_rechecked_independently(scenario, near_opt):
     Gt = np.block([[v["X"], v["Z"]], [v["Y"], v["Z"]]])
     Hbar = np.vstack([v["H"], np.zeros_like(v["H"])])
     Ebar = np.hstack([v["E"], np.zeros_like(v["E"])])
-    M = extended_hinf_matrix(v["Pinf"], Gt.T, Gt @ Abar, Gt @ Bbar, Cbar, Gt @ Hbar, Ebar, v["lam_inf"],
+    M = robust_extended_hinf_negative(v["Pinf"], Gt.T, Gt @ Abar, Gt @ Bbar, Cbar, Gt @ Hbar, Ebar, v["lam_inf"],
                              (gamma_lmi * (1 + 1e-6)) ** 2)
     assert np.linalg.eigvalsh(0.5 * (M + M.T)).max() < 0
     n = s.A.shape[0]

@@ -38,7 +38,7 @@ from ..analysis.norms import hinf_norm
 from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..lmi.augmented_observer import solve_augmented_observer
-from ..lmi.polytopic import extended_hinf_matrix, hinf_gamma_index
+from ..lmi.polytopic import extended_hinf_positive, hinf_gamma_index
 from ..systems.polytopic import simplex_grid
 
 __all__ = ["needs_augmented", "certify_augmented", "augmented_norms", "design_augmented_observer", "cell_weights",
@@ -86,7 +86,7 @@ def certify_augmented(system, A_F, B_F, C_F, witness: Mapping[str, Any]) -> tupl
             if P.shape != Ab.shape or G.shape != Ab.shape:
                 raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the augmented "
                                  f"error system has {Ab.shape[0]} states")
-            N0 = extended_hinf_matrix(P, G @ Ab, G @ Bb, Cb, G, 0.0)
+            N0 = extended_hinf_positive(P, G @ Ab, G @ Bb, Cb, G, 0.0)
             per.append(schur_gamma(-N0, hinf_gamma_index(Ab.shape[0], Bb.shape[1]))[0])
     return max(per), per
 

@@ -24,7 +24,7 @@ from ..analysis.certificates import schur_gamma
 from ..analysis.error_system import worst_case_norm
 from ..core.exceptions import InputError
 from ..lmi.cells_general import solve_cells_general
-from ..lmi.polytopic import extended_hinf_matrix, hinf_gamma_index
+from ..lmi.polytopic import extended_hinf_positive, hinf_gamma_index
 from .augmented import cell_alphas, cell_weights
 
 __all__ = ["certify_cells_general", "design_cells_general"]
@@ -53,7 +53,7 @@ def certify_cells_general(system, A_F, B_F, C_F, witness: Mapping[str, Any]) -> 
             k += 1
             if P.shape != Ab.shape or G.shape != Ab.shape:
                 raise InputError(f"the witness's P {P.shape} or G {G.shape} does not fit the error system {Ab.shape}")
-            N0 = extended_hinf_matrix(P, G @ Ab, G @ Bb, Cb, G, 0.0)
+            N0 = extended_hinf_positive(P, G @ Ab, G @ Bb, Cb, G, 0.0)
             per.append(schur_gamma(-N0, hinf_gamma_index(Ab.shape[0], Bb.shape[1]))[0])
     return max(per), per
 

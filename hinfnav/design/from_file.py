@@ -26,6 +26,7 @@ from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import PolytopicSystem
 from .continuous import ContinuousResult, design_continuous_system
 from .polytopic import COVERS, LYAPUNOV, PolytopicResult, synthesize_polytopic
+from ..lmi.solve import SolverOptions
 from .robust_hinf import synthesize
 
 if TYPE_CHECKING:
@@ -105,5 +106,7 @@ def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | Non
         result = synthesize_polytopic(PolytopicSystem.from_norm_bounded(system), lyapunov=lyapunov, form=form,
                                       solver=solver)
     else:
-        result = synthesize(system, form=form, solver=solver, structure="full")
+        # the state units of a file must not change the design (issue 36): the unit-free scaling
+        result = synthesize(system, form=form, options=SolverOptions.only(solver, state_scaling="units"),
+                            structure="full")
     return result, design_summary(result)

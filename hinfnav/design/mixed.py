@@ -59,7 +59,7 @@ from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from ..lmi.blocks import gamma_index
 from ..lmi.conditioning import prepare
-from ..lmi.mixed_blocks import extended_h2_matrix, extended_hinf_matrix, h2_output_index
+from ..lmi.mixed_blocks import extended_h2_matrix, robust_extended_hinf_negative, h2_output_index
 from ..lmi.mixed_solve import LYAPUNOV, MixedProblem
 from ..lmi.robust_brl import robust_bounded_real_lmi
 from ..lmi.robust_h2 import robust_h2_bound
@@ -353,7 +353,7 @@ class _Designer:
             return _Check(False, "the H2 Lyapunov LMI is not negative definite at the rebuilt filter for any κ",
                           A_F=A_F, B_F=B_F, C_F=C_F)
         if gamma_req is not None:
-            M0 = extended_hinf_matrix(sol.Pinf, G, GA, GB, Cbar, GH, Ebar, sol.lam_inf, 0.0)
+            M0 = robust_extended_hinf_negative(sol.Pinf, G, GA, GB, Cbar, GH, Ebar, sol.lam_inf, 0.0)
             gamma_c, _ = schur_gamma(M0, gamma_index(n, p, q))
         else:
             gamma_c = robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar, Ebar, solver="CVXOPT").gamma

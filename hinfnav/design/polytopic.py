@@ -39,13 +39,14 @@ from ..analysis.norms import h2_norm, hinf_norm
 from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
-from ..lmi.polytopic import extended_h2_matrices, extended_hinf_matrix, hinf_gamma_index, solve_polytopic_hinf
+from ..lmi.polytopic import extended_h2_matrices, extended_hinf_positive, hinf_gamma_index, polytopic_problem
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
 from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
 from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
+from .certify_loop import solve_and_certify
 from .result import FilterDesign, SynthesisResult
 
 __all__ = ["LYAPUNOV", "COVERS", "PolytopicResult", "synthesize_polytopic", "certify_polytopic",
@@ -96,6 +97,8 @@ class PolytopicResult(FilterDesign):
     objective : {"hinf", "h2"}
         With ``"h2"``, ``gamma``, ``lmi_gamma``, ``verified_norm`` and
         ``sample_norms`` are H2 norms (bound and sampled), ``witness`` has W.
+    solver_calls : int
+        Solver invocations of the design.
     """
 
     alphas: np.ndarray
@@ -112,6 +115,7 @@ class PolytopicResult(FilterDesign):
     attempts: tuple = ()
     system: object = None
     objective: str = "hinf"
+    solver_calls: int = 0
 
 
 def _vertex_tuples(system):
@@ -163,7 +167,7 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
         if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape:
             raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the error system "
                              f"has {Abar.shape[0]} states")
-        N0 = extended_hinf_matrix(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
+        N0 = extended_hinf_positive(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
         g, _ = schur_gamma(-N0, hinf_gamma_index(Abar.shape[0], Bbar.shape[1]))
         per.append(g)
     return max(per), per
@@ -296,33 +300,20 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     if form == "general" and objective == "hinf" and system.cells:
         return _cells_result(system, lyapunov, solvers, t0)
     verts = _vertex_tuples(system)
-    log, statuses, best, seconds = [], [], None, 0.0
-    for slv in solvers:
-        sol = solve_polytopic_hinf(verts, form, lyapunov, slv, objective=objective)
-        seconds += sol["seconds"]
-        statuses.append(f"{slv} {sol['status']}")
-        if "P" not in sol:
-            log.append(f"{slv}: status {sol['status']}, no solution")
-            continue
-        tries = [sol]
-        g_s = float(np.sqrt(max(sol["gamma2"], 0.0)))
-        cand = _rebuild_and_certify(system, sol, form, alphas, objective)
-        log.append(f"{slv} minimize: status {sol['status']}, solver γ = {g_s:.10g}, certified γ = {cand[0]:.10g}")
-        if not cand[-1] or cand[0] > g_s * (1 + 1e-3):
-            for step in (1e-5, 1e-4, 1e-3, 1e-2, 1e-1):  # an interior point just above the solver's level certifies better
-                sol2 = solve_polytopic_hinf(verts, form, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2,
-                                            objective=objective)
-                seconds += sol2["seconds"]
-                if "P" in sol2 and sol2["margin"] > 0:
-                    c2 = _rebuild_and_certify(system, sol2, form, alphas, objective)
-                    log.append(f"{slv} feasibility at γ = {g_s * (1 + step):.10g}: certified γ = {c2[0]:.10g}")
-                    if c2[-1] and (not cand[-1] or c2[0] < cand[0]):
-                        cand, tries = c2, [sol2]
-                        break
-        if cand[-1] and (best is None or cand[0] < best[0][0]):
-            best = (cand, tries[0], slv, g_s)
-        if best is not None and best[0][0] <= best[3] * (1 + 1e-5):
-            break  # certified at the solver's own level: the other solvers would not do better
+    problem = polytopic_problem(verts, form, lyapunov, objective=objective)  # built once, re-solved below
+
+    def certify(_, sol):
+        out = _rebuild_and_certify(system, sol.as_dict(), form, alphas, objective)
+        return _PolyCheck(out[-1], out[0], "certified" if out[-1] else "not certified", out)
+
+    # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
+    # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
+    run = solve_and_certify([("as given", problem.solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
+                            steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
+    log, seconds = run.log, run.seconds
+    statuses = [f"{slv} {st}" for slv, st in run.statuses]
+    top = run.best()
+    best = None if top is None else (top.check.data, None, top.solver, top.level)
     if best is None:
         if all(any(s.endswith(st) for st in INFEASIBLE) or "solver error" in s for s in statuses):
             hint = (" With one common Lyapunov matrix the filter must work for arbitrarily time-varying α(k); "
@@ -338,14 +329,14 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
                                      "infeasible, or too ill-conditioned to solve (solver status: "
                                      + "; ".join(statuses) + ")." + hint)
         raise CertificationError("no solution of the extended LMIs passed certification: " + " | ".join(log))
-    (gamma_c, A_F, B_F, C_F, witness, norms, radii, ok), sol, slv, g_s = best
+    (gamma_c, A_F, B_F, C_F, witness, norms, radii, ok), _, slv, g_s = best
     k = int(np.argmax(norms))
     return PolytopicResult(
         A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(gamma_c), lmi_gamma=g_s, verified_norm=float(norms[k]),
         sample_norms=norms, alphas=alphas, worst_sample=k, spectral_radius=float(np.max(radii)),
         lyapunov=lyapunov, form=form, covers=COVERS[lyapunov], witness=witness, solver=slv,
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
-        system=system, objective=objective,
+        system=system, objective=objective, solver_calls=run.calls,
     )
 
 
@@ -391,6 +382,14 @@ def _cells_result(system, lyapunov, solvers, t0):
         witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
         total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
         objective="hinf")
+@dataclass
+class _PolyCheck:
+    """What the certify loop needs of a polytopic certificate (internal)."""
+
+    ok: bool
+    gamma: float
+    reason: str
+    data: tuple
 
 
 def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):

@@ -118,6 +118,9 @@ class SynthesisResult(FilterDesign):
     system : UncertainSystem or None
         The system the filter was designed for (with its sampling time), so
         that a design can be saved with its own system.
+    solver_calls : int
+        Solver invocations of the design (LMI solves; a retry at looser
+        tolerances counts), see :mod:`hinfnav.design.certify_loop`.
     """
 
     worst_sample: int
@@ -136,6 +139,7 @@ class SynthesisResult(FilterDesign):
     form: str = "general"
     sample_labels: tuple = ()
     system: object = None
+    solver_calls: int = 0
 
     @property
     def worst_value(self) -> float | None:

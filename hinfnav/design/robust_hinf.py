@@ -73,18 +73,17 @@ from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least, as_seed
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..lmi.conditioning import lmi20_diagonal, normalize, prepare
-from ..lmi.solve import INFEASIBLE, SolverOptions, solve_lmi
+from ..lmi.solve import SolverOptions, lmi20_problem, solve_lmi
 from ..systems.uncertain import UncertainSystem
 from .arguments import system_argument
 from .explain import infeasibility_hint
 from .polytopic import observer_nominal
 from .result import SynthesisResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
-from .tighten import best_candidate as _best
+from .certify_loop import Candidate, solve_and_certify
+from .tighten import LOOSE_FACTOR, full_lyapunov_gamma, is_loose
 from .tighten import brl_solvers as _brl_solvers
-from .tighten import full_lyapunov_gamma, is_loose
 from .tighten import key as _key
-from .tighten import try_harder as _try_harder
 
 if TYPE_CHECKING:
     from .samples import SampleSet
@@ -105,6 +104,7 @@ class _Check:
     C_F: np.ndarray = None
     wc: WorstCase = None
     variables: dict = None
+    sample: Any = None
 
 
 def _rebuild_and_certify(P, sol, system, samples, dt):
@@ -173,29 +173,37 @@ def _rebuild_and_certify(P, sol, system, samples, dt):
             B_F=B_F,
             C_F=C_F,
         )
-    wc = worst_case_norm(system, A_F, B_F, C_F, samples, dt=1.0)
+    # the sampled norms are computed once, for the candidate about to be returned (see _sampled)
+    chk = _Check(True, "certified", gamma_c, A_F, B_F, C_F, None, variables)
+    chk.sample = lambda: worst_case_norm(system, A_F, B_F, C_F, samples, dt=1.0)
+    return chk
+
+
+def _sampled(chk):
+    """The check with its sampled norms (computed once): refused if a sample is unstable or above γ (internal)."""
+    if chk.wc is not None:
+        return chk
+    wc = chk.wc = chk.sample()
     if not wc.stable:
-        return _Check(
-            False,
-            f"error system not Schur stable at sample {int(np.argmax(wc.spectral_radii))} "
-            f"(spectral radius {np.max(wc.spectral_radii):.10g})",
-            gamma_c,
-            A_F,
-            B_F,
-            C_F,
-            wc,
-        )
-    if wc.norm > gamma_c * (1.0 + 1e-9):
-        return _Check(
-            False,
-            f"sampled H∞ norm {wc.norm:.10g} exceeds the LMI-certified level {gamma_c:.10g}",
-            gamma_c,
-            A_F,
-            B_F,
-            C_F,
-            wc,
-        )
-    return _Check(True, "certified", gamma_c, A_F, B_F, C_F, wc, variables)
+        chk.ok = False
+        chk.reason = (f"error system not Schur stable at sample {int(np.argmax(wc.spectral_radii))} "
+                      f"(spectral radius {np.max(wc.spectral_radii):.10g})")
+    elif wc.norm > chk.gamma * (1.0 + 1e-9):
+        chk.ok = False
+        chk.reason = f"sampled H∞ norm {wc.norm:.10g} exceeds the LMI-certified level {chk.gamma:.10g}"
+    return chk
+
+
+def _best_sampled(run):
+    """The certified candidate of smallest γ whose sampled norms pass; refused ones leave the run (internal)."""
+    while run.candidates:
+        best = run.best()
+        if _sampled(best.check).ok:
+            return best
+        run.log.append(f"{best.solver} {best.how}: refused after sampling: {best.check.reason}")
+        run.candidates.remove(best)
+    return None
+
 
 
 def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "full",
@@ -365,26 +373,55 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     if "SCS" in solvers:
         warnings.warn(_SCS_WARNING, SolverAccuracyWarning, stacklevel=2)
     P = normalize(prepare(system, structure, state_scaling, form), options.normalize_above)
-    run = _Run(options, system, checked_samples, dt_value)
-    for slv in solvers:
-        # once a solution is certified, the other solvers only polish it (one minimization each)
-        how = method if not run.candidates else "minimize"
-        run.solver(P, slv, how)
-        if run.candidates and not polish:
-            break
-    gap = _best(run.candidates)[0] if run.candidates else None
-    if gap and is_loose(*gap) and gap[0] > 1.01 * min(run.hints, default=0.0):
-        # more than 1 % above the solvers' own optimum of (20): the gap may be numerical, so try harder (at the
-        # optimum, other solvers and scalings solve the same LMI and the gap is Lemma 2's)
-        _try_harder(run, P, system, structure, state_scaling, form)
-    if not run.candidates and not run.verdicts and any(st in INFEASIBLE for _, st in run.statuses):
-        for slv in solvers:  # method="minimize" met "infeasible": confirm on the γ-free part before saying so
-            run.gamma_free(P, slv)
-    if run.candidates:
-        (gamma_c, sampled), (chk, sol, slv, how) = _best(run.candidates)
+    other = "units" if isinstance(state_scaling, str) and state_scaling == "balance" else "balance"
+    preps = [P]
+    for Q in (normalize(P, 0.0), normalize(prepare(system, structure, other, form), 0.0)):
+        if all(_key(Q) != _key(R) for R in preps):
+            preps.append(Q)
+    problems = {}
+
+    def solve(i, slv, level):
+        if i not in problems:
+            problems[i] = lmi20_problem(preps[i], options.margin, options.accuracy)
+        return solve_lmi(preps[i], problems[i], slv, level)
+
+    variants = [(_variant_name(Q, P), lambda slv, level, i=i: solve(i, slv, level)) for i, Q in enumerate(preps)]
+    certify = lambda i, sol: _rebuild_and_certify(preps[i], sol, system, checked_samples, dt_value)
+    run = solve_and_certify(variants[:1] if method == "bisection" else variants, solvers, certify, rtol=options.rtol,
+                            max_bisection=options.max_bisection, polish=polish, free=True, method=method)
+    best = _best_sampled(run)
+    if best is not None and is_loose(best.check.gamma, best.check.wc.norm) and \
+            best.check.gamma > 1.01 * min(run.hints, default=0.0):
+        # more than 1 % above the solvers' own optimum of (20): the gap may be numerical, so try harder on the
+        # rescaled data with every interior-point solver (at the optimum the gap is Lemma 2's)
+        run.log.append(f"loose: certified γ = {best.check.gamma:.6g} > {LOOSE_FACTOR:g} × worst sampled norm "
+                       f"{best.check.wc.norm:.6g}; trying harder")
+        hard = [s for s in solvers if s != "SCS"]
+        tried = {slv for slv, _ in run.statuses}
+        for i in range(len(variants)):
+            todo = [s for s in hard if i or s not in tried]
+            if todo and is_loose(_best_sampled(run).check.gamma, run.best().check.wc.norm):
+                solve_and_certify([variants[i]], todo, lambda _, sol, i=i: certify(i, sol), rtol=options.rtol,
+                                  max_bisection=options.max_bisection, free=True, loop=run,
+                                  done=lambda lp: _best_sampled(lp) is not None and
+                                  not is_loose(lp.best().check.gamma, lp.best().check.wc.norm))
+        best = _best_sampled(run)
+        if form == "general" and hard and is_loose(best.check.gamma, best.check.wc.norm):
+            chk = best.check
+            g_full, lyap, lam = full_lyapunov_gamma(P, chk.A_F, chk.B_F, chk.C_F, hard)
+            run.log.append(f"full Lyapunov matrix for the best filter: certified γ = {g_full:.10g}")
+            if chk.wc.norm <= g_full * (1.0 + 1e-9) and g_full < chk.gamma:
+                variables = dict(chk.variables or {}, lyapunov_full=lyap, lam_full=lam, lmi20_gamma=chk.gamma)
+                run.candidates.append(Candidate(dataclasses.replace(chk, gamma=g_full, variables=variables),
+                                                best.sol, best.solver, best.how, best.variant))
+    best = _best_sampled(run)
+    if best is not None:
+        chk, sol, slv, how = best.check, best.sol, best.solver, best.how
+        gamma_c, sampled = chk.gamma, chk.wc.norm
         chk.variables.setdefault("lmi20_gamma", gamma_c)
         if form == "observer":
             gamma_full, lyap, lam_full = full_lyapunov_gamma(P, chk.A_F, chk.B_F, chk.C_F, _brl_solvers(solvers))
+            run.calls += len(_brl_solvers(solvers))  # one robust-BRL solve per solver
             run.log.append(f"observer filter, full Lyapunov matrix (robust BRL): certified γ = {gamma_full:.10g} "
                            f"(LMI (20), restricted Lyapunov matrix: {gamma_c:.10g})")
             if sampled <= gamma_full * (1.0 + 1e-9) and gamma_full < gamma_c:
@@ -423,6 +460,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
             form=form,
             sample_labels=() if sample_set is None else sample_set.labels,
             system=system,
+            solver_calls=run.calls,
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
         hint = infeasibility_hint(system.A, system.H, system.E, structure, form)
@@ -447,132 +485,10 @@ _SCS_WARNING = (
 )
 
 
-class _Run:
-    """State of one synthesis: candidates, log, statuses, γ-free verdicts, solver time (internal)."""
-
-    def __init__(self, options, system, samples, dt):
-        self.options, self.system, self.samples, self.dt = options, system, samples, dt
-        self.candidates, self.log, self.statuses, self.verdicts, self.hints = [], [], [], [], []
-        self.seconds = 0.0
-        self.ran_auto = set()
-
-    def certify(self, P, sol):
-        self.seconds += sol.seconds
-        if sol.R is None:
-            return None
-        return _rebuild_and_certify(P, sol, self.system, self.samples, self.dt)
-
-    def solve(self, P, slv, gamma2=None):
-        o = self.options
-        return solve_lmi(P, slv, o.margin, o.accuracy, gamma2=gamma2)
-
-    def solver(self, P, slv, method):
-        """Minimize, then bisect if needed, with one solver (internal)."""
-        if method != "minimize":
-            self.ran_auto.add((_key(P), slv))
-        found = _run_solver(self, P, slv, method)
-        self.candidates.extend(found)
-        return found
-
-    def gamma_free(self, P, slv):
-        """The most interior point of the γ-free part of (20), on P and then normalised: (sol, chk) or None."""
-        variants = [P]
-        Pn = normalize(P, 0.0)
-        if Pn.nu != P.nu:
-            variants.append(Pn)  # the γ-free part holds L (and A, C, H, E), not B or D
-        for Q in variants:
-            sol = self.solve(Q, slv, "free")
-            chk = self.certify(Q, sol)
-            what = "γ-free feasibility" + (f" (output normalised by {Q.nu:g})" if Q.nu != 1 else "")
-            if chk is None or not sol.margin > 0:
-                self.log.append(f"{slv} {what}: status {sol.status}, margin {sol.margin:.3g}: no interior point")
-                continue
-            self.verdicts.append("feasible" if np.isfinite(chk.gamma) else "interior point not certified")
-            self.log.append(f"{slv} {what}: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
-            return Q, sol, chk
-        self.verdicts.append("infeasible")
-        self.statuses.append((slv, f"infeasible (status {sol.status}, γ-free part's largest margin {sol.margin:.3g})"))
-        return None
-
-
-def _run_solver(run, P, slv, method):
-    """Minimize, then bisect if needed, with one solver; certified candidates (internal)."""
-    o = run.options
-    rtol, max_bisection = o.rtol, o.max_bisection
-    log, statuses = run.log, run.statuses
-    cands = []
-    lo = 0.0
-    if method in ("auto", "minimize"):
-        sol = run.solve(P, slv)
-        statuses.append((slv, sol.status))
-        chk = run.certify(P, sol)
-        if chk is None:
-            log.append(f"{slv} minimize: status {sol.status}, no solution")
-            if method == "minimize":
-                return cands
-            # an "infeasible" minimization is not trusted: the γ-free part below decides
-        else:
-            lmi_g = math.sqrt(max(sol.gamma2, 0.0))
-            run.hints.append(lmi_g if slv != "SCS" else 0.0)  # the solver's optimum of (20), a hint (SCS: none)
-            log.append(f"{slv} minimize: status {sol.status}, solver γ = {lmi_g:.10g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
-            if chk.ok:
-                cands.append((chk, sol, slv, "minimize"))
-                if method == "minimize" or chk.gamma <= lmi_g * (1.0 + rtol):
-                    return cands
-            elif method == "minimize":
-                return cands
-            # the solver's γ is a lower-bound hint only: bisection never returns an uncertified point
-            lo = lmi_g * (1.0 - (10.0 * rtol if sol.status == "optimal" else 1e-2))
-            if not chk.ok and lmi_g > 0:
-                # the solver's point is (slightly) infeasible: look for a certifiable level just above it
-                failures = 0
-                for step in (1e-4, 1e-3, 1e-2, 1e-1, 1.0):
-                    level = lmi_g * (1.0 + step)
-                    sol2 = run.solve(P, slv, level**2)
-                    chk2 = run.certify(P, sol2)
-                    if chk2 is not None and sol2.margin > 0 and chk2.ok:
-                        log.append(f"{slv} feasibility at γ = {level:.10g}: margin {sol2.margin:.3g}, certified γ = {chk2.gamma:.10g}")
-                        cands.append((chk2, sol2, slv, "bisection"))
-                        break
-                    log.append(f"{slv} feasibility at γ = {level:.10g}: status {sol2.status}, not certified")
-                    failures = failures + 1 if sol2.R is None else 0
-                    if failures == 2:
-                        break  # the solver gives no solution at all near its own optimum
-    # bisection on γ with maximum-margin feasibility problems
-    hi = min((c[0].gamma for c in cands), default=None)
-    if hi is None:
-        # the most interior point of the γ-free part of (20): feasible iff (20) is for some γ
-        found = run.gamma_free(P, slv)
-        if found is None:
-            return cands
-        P, sol, chk = found
-        if not chk.ok:
-            return cands
-        sol.gamma2 = chk.gamma**2
-        cands.append((chk, sol, slv, "bisection"))
-        hi = chk.gamma
-    if lo >= hi:
-        lo = 0.0  # the solver's γ was no lower bound (it is above a certified level): start from scratch
-    failures = 0
-    for _ in range(max_bisection):
-        if hi - lo <= rtol * hi:
-            break
-        mid = 0.5 * (lo + hi)
-        sol = run.solve(P, slv, mid**2)
-        chk = run.certify(P, sol)
-        if chk is None or not sol.margin > 0:
-            log.append(f"{slv} feasibility at γ = {mid:.10g}: status {sol.status}, margin {sol.margin:.3g}: infeasible")
-            lo = mid
-            failures = failures + 1 if not np.isfinite(sol.margin) else 0
-            if failures == 3:
-                log.append(f"{slv} bisection stopped: the solver gave no solution three times in a row")
-                break
-            continue
-        failures = 0
-        log.append(f"{slv} feasibility at γ = {mid:.10g}: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
-        if chk.ok and chk.gamma < hi:
-            cands.append((chk, sol, slv, "bisection"))
-            hi = chk.gamma
-        if not chk.ok or chk.gamma > mid:
-            lo = mid  # the solver's claim of feasibility at this level is not confirmed
-    return cands
+def _variant_name(Q, P):
+    """How a rescaled variant of the prepared data differs from ``P`` (for the log)."""
+    if Q is P:
+        return "as prepared"
+    if tuple(Q.sigma) != tuple(P.sigma):
+        return "other state scaling, noise and output normalised"
+    return f"noise and output normalised (ρ = {Q.rho:g}, ν = {Q.nu:g})"

@@ -10,16 +10,13 @@ for a structured filter (observer form) the level of (20) is that of a
 restricted Lyapunov matrix, ``diag(R − S, S)`` in the coordinates (x, e).
 """
 
-import dataclasses
-
 import numpy as np
 
 from ..analysis.certificates import brl_blocks, schur_gamma
 from ..analysis.error_system import error_system_matrices
-from ..lmi.conditioning import normalize, prepare
 from ..lmi.robust_brl import robust_bounded_real_lmi
 
-__all__ = ["LOOSE_FACTOR", "full_lyapunov_gamma", "is_loose", "best_candidate", "brl_solvers", "key", "try_harder"]
+__all__ = ["LOOSE_FACTOR", "full_lyapunov_gamma", "is_loose", "brl_solvers", "key"]
 
 #: A certified γ above this multiple of the worst sampled norm counts as loose.
 LOOSE_FACTOR = 2.0
@@ -95,12 +92,6 @@ def full_lyapunov_gamma(P, A_F, B_F, C_F, solvers):
     return float(gamma), Pl, lam
 
 
-def best_candidate(candidates):
-    """``((certified γ, worst sampled norm), candidate)`` of the smallest certified γ (internal)."""
-    c = min(candidates, key=lambda c: c[0].gamma)
-    return (c[0].gamma, c[0].wc.norm), c
-
-
 def brl_solvers(solvers):
     """Solvers for the full-Lyapunov certificate: the interior-point ones chosen, else those given (internal)."""
     return [s for s in solvers if s != "SCS"] or list(solvers)
@@ -109,42 +100,3 @@ def brl_solvers(solvers):
 def key(P):
     """What identifies a prepared problem's scaling (internal)."""
     return (tuple(P.sigma), P.rho, P.nu)
-
-
-def try_harder(run, P, system, structure, state_scaling, form):
-    """Close a loose certificate (internal; ``run`` is the synthesis state of :func:`synthesize`).
-
-    In order, until the certified γ is within :data:`LOOSE_FACTOR` of the
-    worst sampled norm: every interior-point solver with the full method
-    (minimization, feasibility just above the solver's γ, bisection) on the
-    data as prepared, on the data with noise and output normalised whatever
-    their scale, and with the other state scaling; then, for a general
-    filter, a full Lyapunov matrix for the best filter found
-    (:func:`full_lyapunov_gamma`).
-    """
-    solvers = [s for s in run.options.solvers if s != "SCS"]  # SCS: more of it does not tighten anything
-    if not solvers:
-        return
-    gap = best_candidate(run.candidates)[0]
-    run.log.append(f"loose: certified γ = {gap[0]:.6g} > {LOOSE_FACTOR:g} × worst sampled norm {gap[1]:.6g}; trying harder")
-    other = "none" if isinstance(state_scaling, str) and state_scaling == "balance" else "balance"
-    variants = [P, normalize(P, 0.0), normalize(prepare(system, structure, other, form), 0.0)]
-    seen = set()
-    for Q in variants:
-        if key(Q) in seen:
-            continue
-        seen.add(key(Q))
-        for slv in solvers:
-            if (key(Q), slv) in run.ran_auto:
-                continue
-            run.solver(Q, slv, "auto")
-            if not is_loose(*best_candidate(run.candidates)[0]):
-                return
-    if form == "general":
-        # polish the certificate of the best filter with a full Lyapunov matrix (the filter is kept)
-        (g, sampled), (chk, sol, slv, how) = best_candidate(run.candidates)
-        g_full, lyap, lam = full_lyapunov_gamma(P, chk.A_F, chk.B_F, chk.C_F, solvers)
-        run.log.append(f"full Lyapunov matrix for the best filter: certified γ = {g_full:.10g}")
-        if sampled <= g_full * (1.0 + 1e-9) and g_full < g:
-            variables = dict(chk.variables or {}, lyapunov_full=lyap, lam_full=lam, lmi20_gamma=g)
-            run.candidates.append((dataclasses.replace(chk, gamma=g_full, variables=variables), sol, slv, how))

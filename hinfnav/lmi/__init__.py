@@ -7,9 +7,9 @@ trusted here: :mod:`hinfnav.design` certifies them with :mod:`hinfnav.analysis`.
 
 from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
 from .conditioning import Prepared, pow2, prepare, prepare_uncertainty, state_scaling
-from .polytopic import extended_h2_matrices, extended_hinf_matrix, solve_polytopic_hinf
+from .polytopic import extended_h2_matrices, extended_hinf_positive, solve_polytopic_hinf
 from .robust_brl import robust_bounded_real_lmi
-from .solve import INFEASIBLE, METHODS, SOLVERS, Solution, SolverOptions, solve_lmi
+from .solve import INFEASIBLE, METHODS, SOLVERS, LMIProblem, Solution, SolverOptions, lmi20_problem, run_solver, solve_lmi
 
 __all__ = [
     "lmi20_matrix",
@@ -26,8 +26,11 @@ __all__ = [
     "SolverOptions",
     "Solution",
     "solve_lmi",
+    "lmi20_problem",
+    "LMIProblem",
+    "run_solver",
     "robust_bounded_real_lmi",
-    "extended_hinf_matrix",
+    "extended_hinf_positive",
     "extended_h2_matrices",
     "solve_polytopic_hinf",
 ]

@@ -40,7 +40,7 @@ import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .polytopic import extended_hinf_matrix
+from .polytopic import extended_hinf_positive
 from .solve import solver_kwargs
 
 __all__ = ["solve_augmented_observer"]
@@ -99,7 +99,7 @@ def solve_augmented_observer(cells: Sequence[Sequence[Sequence[ArrayLike]]], T: 
             GA = cp.bmat([[G11 @ As, np.zeros((ns, n))], [G21 @ As + G22 @ dA + Ghat @ dC, G22 @ A0 + Ghat @ C0]])
             GB = cp.bmat([[G11 @ (T @ B), np.zeros((ns, q))], [G21 @ (T @ B) + G22 @ B, Ghat @ D]])
             Cbar = np.hstack([(L - L0) @ T.T, L0])
-            M = extended_hinf_matrix(P, GA, GB, Cbar, G, g, bmat=cp.bmat)
+            M = extended_hinf_positive(P, GA, GB, Cbar, G, g, bmat=cp.bmat)
             cons.append(0.5 * (M + M.T) >> t * np.eye(M.shape[0]))
             if common is None:
                 cons.append(P << bound * np.eye(N))

@@ -20,7 +20,7 @@ import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .polytopic import extended_hinf_matrix, filter_slack_products
+from .polytopic import extended_hinf_positive, filter_slack_products
 from .solve import solver_kwargs
 
 __all__ = ["solve_cells_general"]
@@ -53,7 +53,7 @@ def solve_cells_general(cells: Sequence[Sequence[Sequence[ArrayLike]]], lyapunov
         for P, vert in zip(cell_P, vertices):
             vert = tuple(np.asarray(M, dtype=float) for M in vert)
             GA, GB, Cbar = filter_slack_products(vert, X, Z, V, Ahat, Bhat, CF, bmat=cp.bmat)
-            M = extended_hinf_matrix(P, GA, GB, Cbar, G, g, bmat=cp.bmat)
+            M = extended_hinf_positive(P, GA, GB, Cbar, G, g, bmat=cp.bmat)
             cons.append(0.5 * (M + M.T) >> t * np.eye(M.shape[0]))
             if common is None:
                 cons.append(P << bound * np.eye(2 * n))

@@ -43,7 +43,7 @@ import numpy as np
 
 __all__ = [
     "slack_products",
-    "extended_hinf_matrix",
+    "robust_extended_hinf_negative",
     "extended_h2_matrix",
     "h2_trace_matrix",
     "h2_output_index",
@@ -91,7 +91,7 @@ def slack_products(A, B, C, D, L, H, E, X, Y, Z, Abar_F, Bbar_F, Cbar_F, bmat=np
     return out
 
 
-def extended_hinf_matrix(P, G, GA, GB, Cbar, GH, Ebar, lam, gamma2, bmat=np.block):
+def robust_extended_hinf_negative(P, G, GA, GB, Cbar, GH, Ebar, lam, gamma2, bmat=np.block):
     """Extended robust bounded real LMI (H∞ part), negative definite iff the bound holds.
 
     Block rows/columns ``[N, N, p + q, l, r]`` (N = 2n; the last only with

@@ -7,7 +7,7 @@
     subject to  extended H2 LMIs (:func:`.mixed_blocks.extended_h2_matrix`,
                 :func:`.mixed_blocks.h2_trace_matrix`)
                 and, unless γ is None, the robust H∞ LMI at the level γ
-                (``lyapunov="extended"``: :func:`.mixed_blocks.extended_hinf_matrix`;
+                (``lyapunov="extended"``: :func:`.mixed_blocks.robust_extended_hinf_negative`;
                 ``"common"``: LMI (20) itself, :func:`.blocks.lmi20_matrix`).
 
 γ² is a cvxpy ``Parameter``: a Pareto front re-solves the same compiled
@@ -15,8 +15,6 @@ problem. Solutions are never trusted here; :mod:`hinfnav.design.mixed`
 certifies them.
 """
 
-import time
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -24,8 +22,8 @@ import numpy as np
 
 from ..core.validation import as_choice
 from .blocks import lmi20_matrix
-from .mixed_blocks import extended_h2_matrix, extended_hinf_matrix, h2_trace_matrix, slack_products
-from .solve import solver_kwargs
+from .mixed_blocks import extended_h2_matrix, robust_extended_hinf_negative, h2_trace_matrix, slack_products
+from .solve import run_solver
 
 __all__ = ["LYAPUNOV", "MixedSolution", "MixedProblem"]
 
@@ -113,7 +111,7 @@ class MixedProblem:
             lam_inf = cp.Variable() if H is not None else 0.0
             if self.lyapunov == "extended":
                 Pinf = cp.Variable((N, N), symmetric=True)
-                Minf = extended_hinf_matrix(Pinf, sp["G"], sp["GA"], sp["GB"], sp["Cbar"], sp["GH"], sp["Ebar"],
+                Minf = robust_extended_hinf_negative(Pinf, sp["G"], sp["GA"], sp["GB"], sp["Cbar"], sp["GH"], sp["Ebar"],
                                             lam_inf, self.gamma2, bmat=cp.bmat)
                 cons.append(_sym(Pinf) << bound * eye(N))
             else:
@@ -134,18 +132,9 @@ class MixedProblem:
         """
         if self.hinf:
             self.gamma2.value = float(gamma2)
-        start = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            for acc in (accuracy, 100.0 * accuracy):
-                try:
-                    self.problem.solve(solver=solver, **solver_kwargs(solver, acc))
-                    break
-                except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-                    error = exc
-            else:
-                return MixedSolution(f"solver error ({error})", float("nan"), seconds=time.perf_counter() - start)
-        seconds = time.perf_counter() - start
+        status, seconds, _ = run_solver(self.problem, solver, accuracy)
+        if status.startswith("solver error"):
+            return MixedSolution(status, float("nan"), seconds=seconds)
         v = self._vars
         status = str(self.problem.status)
         if v["X"].value is None or v["W"].value is None:

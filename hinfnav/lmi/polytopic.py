@@ -39,8 +39,6 @@ plant state); only (A, C) detectable is needed, not a stable A.
 
 from __future__ import annotations
 
-import time
-import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -48,13 +46,13 @@ import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .solve import solver_kwargs
+from .solve import LMIProblem
 
-__all__ = ["extended_hinf_matrix", "hinf_gamma_index", "solve_polytopic_hinf", "filter_slack_products",
+__all__ = ["extended_hinf_positive", "hinf_gamma_index", "solve_polytopic_hinf", "polytopic_problem", "filter_slack_products",
            "extended_h2_matrices"]
 
 
-def extended_hinf_matrix(P: ArrayLike | cp.Expression, GA: ArrayLike | cp.Expression, GB: ArrayLike | cp.Expression, Cbar: ArrayLike | cp.Expression,
+def extended_hinf_positive(P: ArrayLike | cp.Expression, GA: ArrayLike | cp.Expression, GB: ArrayLike | cp.Expression, Cbar: ArrayLike | cp.Expression,
                          G: ArrayLike | cp.Expression, gamma2: float | cp.Expression, bmat: Callable[..., Any] = np.block) -> NDArray[np.float64] | cp.Expression:
     """The matrix N of (E1) (positive definite iff the bound holds), from the products ``G Ā`` and ``G B̄``.
 
@@ -136,70 +134,68 @@ def solve_polytopic_hinf(vertices: Sequence[Sequence[ArrayLike]], form: str = "g
         ``P`` (list, one per vertex), ``G``, the filter ``A_F, B_F, C_F``
         and the raw variables (``X, Z, V, Ahat, Bhat`` or ``Ghat``).
     """
+    return polytopic_problem(vertices, form, lyapunov, margin, accuracy, bound, objective).solve(solver, gamma2).as_dict()
+
+
+def polytopic_problem(vertices: Sequence[Sequence[ArrayLike]], form: str = "general",
+                      lyapunov: str = "parameter-dependent", margin: float = 1e-8, accuracy: float = 1e-8,
+                      bound: float = 1e6, objective: str = "hinf") -> LMIProblem:
+    """(E1) (or (E2) for H2) at every vertex as one :class:`~hinfnav.lmi.solve.LMIProblem`, built once.
+
+    The level is γ² (``tr W`` for H2); ``Pᵢ ≤ bound·I`` keeps the problem
+    bounded. The solution's values: ``P`` (list, one per vertex), ``G`` and
+    the raw variables (``X, Z, V, Ahat, Bhat, C_F`` or ``Ghat``; ``W``).
+    """
     A0, B0, C0, D0, L0 = vertices[0]
     n, p = B0.shape
     m, q = D0.shape
     l = L0.shape[0]
     nv = len(vertices)
-    g = cp.Variable() if gamma2 is None else float(gamma2)
-    t = margin if gamma2 is None else cp.Variable()
-    cons = []
-    if form == "observer":
-        N = n
-        G = cp.Variable((n, n))
-        Ghat = cp.Variable((n, m))
-        prods = []
-        for A, B, C, D, L in vertices:
-            GA = G @ A + Ghat @ C
-            GB = cp.hstack([G @ B, Ghat @ D])
-            prods.append((GA, GB, L))
-        raw = {"Ghat": Ghat}
-    else:
-        N = 2 * n
-        X, Z, V = cp.Variable((n, n)), cp.Variable((n, n)), cp.Variable((n, n))
-        Ahat, Bhat, CF = cp.Variable((n, n)), cp.Variable((n, m)), cp.Variable((l, n))
-        G = cp.bmat([[X, V], [Z, V]])
-        prods = [filter_slack_products(v, X, Z, V, Ahat, Bhat, CF, bmat=cp.bmat) for v in vertices]
-        raw = {"X": X, "Z": Z, "V": V, "Ahat": Ahat, "Bhat": Bhat, "C_F": CF}
-    if lyapunov == "common":
-        Ps = [cp.Variable((N, N), symmetric=True)] * nv
-    else:
-        Ps = [cp.Variable((N, N), symmetric=True) for _ in range(nv)]
-    if objective == "h2":
-        k = prods[0][1].shape[1]
-        W = cp.Variable((k, k), symmetric=True)
-        raw["W"] = W
-        if gamma2 is None:
-            g = cp.trace(W)
+
+    def build(t, free):
+        g = cp.Variable()
+        cons = []
+        if form == "observer":
+            N = n
+            G = cp.Variable((n, n))
+            Ghat = cp.Variable((n, m))
+            prods = []
+            for A, B, C, D, L in vertices:
+                prods.append((G @ A + Ghat @ C, cp.hstack([G @ B, Ghat @ D]), L))
+            raw = {"Ghat": Ghat}
         else:
-            cons.append(cp.trace(W) <= float(gamma2))
-    for P, (GA, GB, Cbar) in zip(Ps, prods):
+            N = 2 * n
+            X, Z, V = cp.Variable((n, n)), cp.Variable((n, n)), cp.Variable((n, n))
+            Ahat, Bhat, CF = cp.Variable((n, n)), cp.Variable((n, m)), cp.Variable((l, n))
+            G = cp.bmat([[X, V], [Z, V]])
+            prods = [filter_slack_products(v, X, Z, V, Ahat, Bhat, CF, bmat=cp.bmat) for v in vertices]
+            raw = {"X": X, "Z": Z, "V": V, "Ahat": Ahat, "Bhat": Bhat, "C_F": CF}
+        if lyapunov == "common":
+            Ps = [cp.Variable((N, N), symmetric=True)] * nv
+        else:
+            Ps = [cp.Variable((N, N), symmetric=True) for _ in range(nv)]
         if objective == "h2":
-            mats = extended_h2_matrices(P, GA, GB, Cbar, G, W, bmat=cp.bmat)
-        else:
-            mats = (extended_hinf_matrix(P, GA, GB, Cbar, G, g, bmat=cp.bmat),)
-        for M in mats:
-            cons.append(0.5 * (M + M.T) >> t * np.eye(M.shape[0]))
-    for P in (Ps[:1] if lyapunov == "common" else Ps):
-        cons.append(P << bound * np.eye(N))
-    if gamma2 is None:
-        prob = cp.Problem(cp.Minimize(g), cons)
-    else:
-        prob = cp.Problem(cp.Maximize(t), cons + [t <= 1e-3 * min(1.0, float(gamma2))])
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma2": float("nan"), "seconds": time.perf_counter() - start}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma2": float(g.value) if gamma2 is None and g.value is not None else (
-               float("nan") if gamma2 is None else float(gamma2))}
-    if G.value is None or any(P.value is None for P in Ps):
-        return out
-    out["P"] = [0.5 * (P.value + P.value.T) for P in Ps]
-    out["G"] = np.array(G.value)
-    out["margin"] = margin if gamma2 is None else float(t.value)
-    out.update({k: np.array(v.value) for k, v in raw.items()})
-    return out
+            k = prods[0][1].shape[1]
+            W = cp.Variable((k, k), symmetric=True)
+            raw["W"] = W
+            g = cp.trace(W)
+        for P, (GA, GB, Cbar) in zip(Ps, prods):
+            if objective == "h2":
+                mats = extended_h2_matrices(P, GA, GB, Cbar, G, W, bmat=cp.bmat)
+            else:
+                mats = (extended_hinf_positive(P, GA, GB, Cbar, G, g, bmat=cp.bmat),)
+            for M in mats:
+                cons.append(0.5 * (M + M.T) >> t * np.eye(M.shape[0]))
+        for P in (Ps[:1] if lyapunov == "common" else Ps):
+            cons.append(P << bound * np.eye(N))
+
+        def readout():
+            if G.value is None or any(P.value is None for P in Ps):
+                return {}
+            out = {"P": [0.5 * (P.value + P.value.T) for P in Ps], "G": np.array(G.value)}
+            out.update({k: np.array(v.value) for k, v in raw.items()})
+            return out
+
+        return cons, g, readout
+
+    return LMIProblem(build, margin, accuracy, retry=False)

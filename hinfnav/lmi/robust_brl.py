@@ -7,8 +7,6 @@ norm-bounded uncertainty for a given error system; the solution is checked by
 
 from __future__ import annotations
 
-import warnings
-
 import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,6 +14,7 @@ from numpy.typing import ArrayLike
 from ..analysis.certificates import LMICertificate, brl_blocks, schur_gamma
 from ..core.linalg import sym
 from .blocks import error_system_matrices
+from .solve import LMIProblem
 
 __all__ = ["robust_bounded_real_lmi"]
 
@@ -68,23 +67,22 @@ def robust_bounded_real_lmi(Abar: ArrayLike, Bbar: ArrayLike, Cbar: ArrayLike, H
 
 def _robust_brl_once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin):
     N = Abar.shape[0]
-    P = cp.Variable((N, N), symmetric=True)
-    lam = cp.Variable() if Hbar is not None else 0.0
-    g = cp.Variable()
-    M = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, cp.bmat)
-    size = M.shape[0]
-    prob = cp.Problem(cp.Minimize(g), [0.5 * (M + M.T) << -margin * np.eye(size)])
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prob.solve(solver=solver)
-    except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: solver error ({exc})")
-    if P.value is None:
-        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: {prob.status}")
-    Pv = sym(P.value)
-    lamv = float(lam.value) if Hbar is not None else 0.0
+
+    def build(t, free):
+        P = cp.Variable((N, N), symmetric=True)
+        lam = cp.Variable() if Hbar is not None else 0.0
+        g = cp.Variable()
+        M = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, P, lam, g, cp.bmat)
+        readout = lambda: {} if P.value is None else {
+            "P": sym(P.value), "lam": float(lam.value) if Hbar is not None else 0.0}
+        return [0.5 * (M + M.T) << -t * np.eye(M.shape[0])], g, readout
+
+    # the solver's own tolerances (as this certificate always had), one solve (no retry)
+    sol = LMIProblem(build, margin, accuracy=None, retry=False).solve(solver)
+    if not sol.solved:
+        return LMICertificate(float("inf"), float("nan"), None, float("nan"), f"{solver}: {sol.status}")
+    Pv, lamv = sol.P, sol.lam
     M0 = brl_blocks(Abar, Bbar, Cbar, Hbar, Ebar, Pv, lamv, 0.0, np.block)
     nin = Bbar.shape[1]
     gamma, _ = schur_gamma(M0, np.arange(2 * N, 2 * N + nin))
-    return LMICertificate(gamma, float(np.sqrt(max(g.value, 0.0))), Pv, lamv, f"{solver}: {prob.status}")
+    return LMICertificate(gamma, float(np.sqrt(max(sol.gamma2, 0.0))), Pv, lamv, f"{solver}: {sol.status}")

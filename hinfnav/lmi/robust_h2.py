@@ -20,7 +20,6 @@ Lyapunov matrix for the filter found.
 """
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -29,7 +28,7 @@ import numpy as np
 from ..analysis.certificates import schur_gamma
 from .blocks import error_system_matrices
 from .mixed_blocks import extended_h2_matrix
-from .solve import solver_kwargs
+from .solve import LMIProblem
 
 __all__ = ["H2Certificate", "robust_h2_bound"]
 
@@ -107,21 +106,19 @@ def robust_h2_bound(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None, margin=
 
 def _once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin, bound, accuracy):
     N = Abar.shape[0]
-    P = cp.Variable((N, N), symmetric=True)
-    lam = cp.Variable() if Hbar is not None else 0.0
-    GH = None if Hbar is None else P @ Hbar
-    M = extended_h2_matrix(P, P, P @ Abar, Cbar, GH, Ebar, lam, 1.0, bmat=cp.bmat)
-    cons = [0.5 * (M + M.T) << -margin * np.eye(M.shape[0]), P << bound * np.eye(N)]
-    prob = cp.Problem(cp.Minimize(cp.trace(Bbar.T @ P @ Bbar)), cons)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-    except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-        return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: error ({exc})")
-    if P.value is None:
-        return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: {prob.status}")
-    Pv = 0.5 * (P.value + P.value.T)
-    lamv = float(lam.value) if Hbar is not None else 0.0
-    nu, kappa = _certify(Abar, Bbar, Cbar, Hbar, Ebar, Pv, lamv)
-    return H2Certificate(nu, math.sqrt(max(float(prob.value), 0.0)), Pv, lamv, kappa, f"{solver}: {prob.status}")
+
+    def build(t, free):
+        P = cp.Variable((N, N), symmetric=True)
+        lam = cp.Variable() if Hbar is not None else 0.0
+        GH = None if Hbar is None else P @ Hbar
+        M = extended_h2_matrix(P, P, P @ Abar, Cbar, GH, Ebar, lam, 1.0, bmat=cp.bmat)
+        cons = [0.5 * (M + M.T) << -t * np.eye(M.shape[0]), P << bound * np.eye(N)]
+        readout = lambda: {} if P.value is None else {
+            "P": 0.5 * (P.value + P.value.T), "lam": float(lam.value) if Hbar is not None else 0.0}
+        return cons, cp.trace(Bbar.T @ P @ Bbar), readout
+
+    sol = LMIProblem(build, margin, accuracy, retry=False).solve(solver)
+    if not sol.solved:
+        return H2Certificate(float("inf"), float("nan"), None, float("nan"), float("nan"), f"{solver}: {sol.status}")
+    nu, kappa = _certify(Abar, Bbar, Cbar, Hbar, Ebar, sol.P, sol.lam)
+    return H2Certificate(nu, math.sqrt(max(sol.gamma2, 0.0)), sol.P, sol.lam, kappa, f"{solver}: {sol.status}")

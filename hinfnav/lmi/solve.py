@@ -1,4 +1,4 @@
-"""One cvxpy solve of LMI (20), and the solver strategy object.
+"""The one solve module of the LMI designs: a problem built once, one solver call path, one solution type.
 
 :class:`SolverOptions` holds every solver choice of a synthesis (which
 solvers, in which order, method, margins, tolerances, bisection, polishing,
@@ -12,7 +12,7 @@ import math
 import numbers
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import cvxpy as cp
@@ -27,7 +27,8 @@ from .forksafety import note_solve
 if TYPE_CHECKING:
     from .conditioning import Prepared
 
-__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SolverOptions", "Solution", "solve_lmi"]
+__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
+           "run_solver", "lmi20_problem", "solve_lmi"]
 
 #: Solvers the synthesis accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")
@@ -71,8 +72,12 @@ class SolverOptions:
         default chain was Clarabel then a CVXOPT polish, and CVXOPT's design
         won at every δ̄ of Sun et al. (2011)'s sweep, general and observer
         form, so CVXOPT alone returns the same filters at a third of the cost).
-    state_scaling : {"balance", "none"} or tuple of float
-        Diagonal state-coordinate scaling (rounded to powers of two).
+    state_scaling : {"balance", "units", "none"} or tuple of float
+        Diagonal state-coordinate scaling: ``"balance"`` (default) balances
+        A by powers of two; ``"units"`` first removes the state units
+        (:func:`hinfnav.lmi.conditioning.unit_scaling`: the design does not
+        depend on them; used by ``design --system``); a tuple gives the
+        factors (rounded to powers of two).
     normalize_above : float
         Scale of the noise block (B, D) or of the output block (L) above
         which it is normalised by a power of two before solving, and the
@@ -111,7 +116,9 @@ class SolverOptions:
         object.__setattr__(self, "max_bisection", as_int_at_least("max_bisection", self.max_bisection, 1))
         if not isinstance(self.polish, (bool, np.bool_)):
             raise InputError(f"polish must be True or False; got {self.polish!r}")
-        if not isinstance(self.state_scaling, str):
+        if isinstance(self.state_scaling, str):
+            as_choice("state_scaling", self.state_scaling, ("balance", "units", "none"))
+        else:
             object.__setattr__(self, "state_scaling", tuple(float(v) for v in np.ravel(self.state_scaling)))
         na = self.normalize_above
         if isinstance(na, bool) or not isinstance(na, numbers.Real) or math.isnan(na) or na < 0:
@@ -128,16 +135,56 @@ class SolverOptions:
 
 @dataclass
 class Solution:
+    """What one solve of an LMI problem returns (every LMI design of hinfnav uses this one type).
+
+    Attributes
+    ----------
+    status : str
+        cvxpy's status, or ``"solver error (...)"``.
+    gamma2 : float
+        The level: the solver's minimum of γ² (minimisation), the level
+        asked for (feasibility), NaN for the γ-free problem or no solution.
+    values : dict
+        The variables at the solution, by name (empty: no solution).
+    margin : float
+        Strictness margin t of ``M ≤ −t·I`` (feasibility: maximised).
+    seconds : float
+        Wall time of the solve(s).
+    solver : str
+    calls : int
+        Solver invocations made (a retry at looser tolerances counts).
+    """
+
     status: str
     gamma2: float
-    R: np.ndarray = None
-    S: np.ndarray = None
-    Abar_F: np.ndarray = None
-    Bbar_F: np.ndarray = None
-    Cbar_F: np.ndarray = None
-    lam: float = 0.0
+    values: dict = field(default_factory=dict)
     margin: float = float("nan")
     seconds: float = 0.0
+    solver: str = ""
+    calls: int = 0
+
+    @property
+    def solved(self) -> bool:
+        """Whether the solver returned values for the variables."""
+        return bool(self.values)
+
+    def __getattr__(self, name: str) -> Any:
+        values = self.__dict__.get("values") or {}
+        if name in values:
+            return values[name]
+        if name in ("R", "S", "Abar_F", "Bbar_F", "Cbar_F"):
+            return None  # LMI (20)'s variables when nothing was solved
+        if name == "lam":
+            return 0.0
+        raise AttributeError(f"Solution has no value {name!r}")
+
+    def as_dict(self) -> dict:
+        """``status``, ``gamma2``, ``seconds``, and when solved ``margin`` and the values (a flat dict)."""
+        out = {"status": self.status, "gamma2": self.gamma2, "seconds": self.seconds}
+        if self.solved:
+            out["margin"] = self.margin
+            out.update(self.values)
+        return out
 
 
 #: Seconds one SCS solve may take (SCS's ``time_limit_secs``): SCS on LMI (20) otherwise runs for minutes
@@ -156,135 +203,179 @@ def solver_kwargs(solver, accuracy):
     return {}
 
 
-def solve_lmi(P: Prepared, solver: str, margin: float, accuracy: float, gamma2: float | None = None,
-              bound: float = 1e8) -> Solution:
-    """One cvxpy solve of LMI (20) on prepared data (internal).
+#: Exceptions a cvxpy solve may raise on a hard LMI (CVXOPT raises ArithmeticError from inside LAPACK).
+SOLVER_ERRORS = (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError)
+
+
+def run_solver(prob: cp.Problem, solver: str, accuracy: float | None = None, retry: bool = True
+               ) -> tuple[str, float, int]:
+    """Solve one cvxpy problem: the only place where hinfnav calls a solver.
+
+    ``accuracy=None`` uses the solver's own defaults. Otherwise the
+    tolerances of :func:`solver_kwargs`; a solver that raises (CVXOPT's
+    residuals often stall near 1e-7 and it stops with a singular KKT
+    matrix) is asked once more with 100x looser tolerances when ``retry``.
+
+    Returns
+    -------
+    status : str
+        cvxpy's status, or ``"solver error (...)"``.
+    seconds : float
+    calls : int
+        Solver invocations (1 or 2).
+    """
+    start = time.perf_counter()
+    tries = (None,) if accuracy is None else ((accuracy, 100.0 * accuracy) if retry else (accuracy,))
+    error = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for calls, acc in enumerate(tries, start=1):
+            try:
+                prob.solve(solver=solver, **({} if acc is None else solver_kwargs(solver, acc)))
+                return str(prob.status), time.perf_counter() - start, calls
+            except SOLVER_ERRORS as exc:
+                error = exc
+    return f"solver error ({error})", time.perf_counter() - start, len(tries)
+
+
+class LMIProblem:
+    """An LMI problem in a level γ², built once, solved in three ways.
+
+    ``build(t, free)`` returns ``(constraints, level, readout)``: the
+    constraints with the strictness margin ``t`` (a number, or a cvxpy
+    variable), the expression of the level (γ², or ``tr W`` for H2; ``None``
+    when ``free``) and a function returning the variables' values as a dict.
+    The three problems, each built on first use and then kept (cvxpy
+    re-solves a built problem without canonicalising it again):
+
+    * ``solve(solver)``: minimise the level subject to the constraints at
+      ``t = margin``;
+    * ``solve(solver, gamma2=x)``: feasibility at level ``≤ x`` (a cvxpy
+      Parameter), maximising t up to ``1e-3·min(1, x)`` (an interior point,
+      which certifies well; a cap near the natural scale of the LMIs makes
+      the solvers fail or report "unbounded");
+    * ``solve(solver, gamma2="free")``: the same for the γ-free part
+      (``build(t, True)``).
+
+    ``calls`` counts every solver invocation of the problem.
+    """
+
+    def __init__(self, build: Any, margin: float = 1e-8, accuracy: float | None = 1e-8, retry: bool = True):
+        self._build, self.margin, self.accuracy, self.retry = build, margin, accuracy, retry
+        self._problems: dict = {}
+        self.calls = 0
+        self.seconds = 0.0
+
+    def _problem(self, kind):
+        if kind not in self._problems:
+            if kind == "min":
+                cons, level, readout = self._build(self.margin, False)
+                self._problems[kind] = (cp.Problem(cp.Minimize(level), cons), level, None, None, readout)
+            else:
+                t = cp.Variable()
+                cons, level, readout = self._build(t, kind == "free")
+                gpar, cap = cp.Parameter(nonneg=True), cp.Parameter(nonneg=True)
+                extra = [t <= cap] if kind == "free" else [level <= gpar, t <= cap]
+                self._problems[kind] = (cp.Problem(cp.Maximize(t), cons + extra), t, gpar, cap, readout)
+        return self._problems[kind]
+
+    def solve(self, solver: str, gamma2: float | str | None = None) -> Solution:
+        """Minimise (``gamma2=None``), or maximise the margin at a level (a number) or γ-free (``"free"``)."""
+        kind = "min" if gamma2 is None else ("free" if isinstance(gamma2, str) else "level")
+        prob, var, gpar, cap, readout = self._problem(kind)
+        if kind == "level":
+            gpar.value = float(gamma2)
+            cap.value = 1e-3 * min(1.0, float(gamma2))
+        elif kind == "free":
+            cap.value = 1e-3
+        status, seconds, calls = run_solver(prob, solver, self.accuracy, self.retry)
+        self.calls += calls
+        self.seconds += seconds
+        values = readout() if not status.startswith("solver error") else {}
+        if kind == "min":
+            level = float(var.value) if values and var.value is not None else float("nan")
+            margin = self.margin
+        else:
+            level = float(gamma2) if kind == "level" else float("nan")
+            margin = float(var.value) if values and var.value is not None else float("nan")
+        return Solution(status, level, values, margin, seconds, solver, calls)
+
+
+def lmi20_problem(P: Prepared, margin: float = 1e-8, accuracy: float = 1e-8, bound: float = 1e8) -> LMIProblem:
+    """LMI (20) (or its observer form) on prepared data, built once (:class:`LMIProblem`).
 
     When ``P`` is normalised (:func:`hinfnav.lmi.conditioning.normalize`),
-    the solver sees the normalised data, and ``gamma2`` and the returned
-    solution are in the units of the original data: ``γ'² = γ²/(νρ)²`` is
-    solved for, and ``R, S, Ā_F, B̄_F, λ`` come back multiplied by ν²,
-    ``C̄_F`` by ν and γ² by (νρ)² (exact, powers of two); the margin is the
-    normalised problem's (its sign is what matters).
-
-    ``gamma2=None``: minimize γ² subject to (20) ≤ −margin·I (Corollary 1).
-    ``gamma2`` a number: feasibility at that level, maximizing the margin t
-    in (20) ≤ −t·I up to a cap (an interior point, which certifies well).
-    ``gamma2="free"``: the same for the γ-free part of (20) (its rows and
-    columns without −γ²I); it is feasible iff (20) is for some finite γ.
-    The solution's ``gamma2`` is then NaN (the certificate finds γ).
+    the solver sees the normalised data, and the levels asked for and the
+    solutions returned by :func:`solve_lmi` are in the units of the original
+    data.
 
     With ``P.form == "observer"`` the equality constraints
     ``Ā_F = S A + B̄_F C`` and ``C̄_F = −L`` (in the scaled coordinates of
     ``P``) are eliminated by substitution, and the LMI is posed in its
     congruent form :func:`observer_lmi_matrix` (variables X = R − S, S,
     B̄_F, λ), on which the solvers converge (on (20) with the substitution
-    they stop with numerical errors near the optimum).
+    they stop with numerical errors near the optimum). The γ-free part is
+    (20) without the rows and columns of −γ²I: feasible iff (20) is for some
+    finite γ. ``R ≤ bound·I`` bounds every variable when (20) holds
+    (S < R, ‖Ā_F‖² ≤ ‖R‖‖S‖, λ‖E‖² < ‖R‖, ...).
+    """
+    n, p = P.B.shape
+    q = P.D.shape[1]
+    observer = P.form == "observer"
+
+    def build(t, free):
+        # variables created in the same order as before the observer option: identical general-form problems
+        X = cp.Variable((n, n), symmetric=True)  # R in the general form, R − S in the observer form
+        S = cp.Variable((n, n), symmetric=True)
+        AbF = None if observer else cp.Variable((n, n))
+        BbF = cp.Variable((n, P.C.shape[0]))
+        CbF = None if observer else cp.Variable((P.L.shape[0], n))
+        lam = cp.Variable() if P.H is not None else 0.0
+        g = 0.0 if free else cp.Variable()
+        if observer:
+            R = X + S
+            M = observer_lmi_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, X, S, BbF, lam, g, bmat=cp.bmat)
+        else:
+            R = X
+            M = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, R, S, AbF, BbF, CbF, lam, g, bmat=cp.bmat)
+        if free:
+            keep = np.setdiff1d(np.arange(M.shape[0]), gamma_index(n, p, q))
+            M = M[keep, :][:, keep]
+        Msym = 0.5 * (M + M.T)
+        cons = [Msym << -t * np.eye(M.shape[0]), R << bound * np.eye(n)]
+
+        def readout():
+            if X.value is None or S.value is None:
+                return {}
+            sym = lambda Y: 0.5 * (Y + Y.T)
+            S_val = sym(S.value)
+            if observer:
+                R_val, Abar, Cbar = S_val + sym(X.value), S_val @ P.A + BbF.value @ P.C, -P.L.copy()
+            else:
+                R_val, Abar, Cbar = sym(X.value), AbF.value.copy(), CbF.value.copy()
+            return {"R": R_val, "S": S_val, "Abar_F": Abar, "Bbar_F": BbF.value.copy(), "Cbar_F": Cbar,
+                    "lam": float(lam.value) if P.H is not None else 0.0}
+
+        return cons, (None if free else g), readout
+
+    return LMIProblem(build, margin, accuracy)
+
+
+def solve_lmi(P: Prepared, problem: LMIProblem, solver: str, gamma2: float | str | None = None) -> Solution:
+    """One solve of LMI (20) built by :func:`lmi20_problem` on ``P``, in the units of the original data.
+
+    ``gamma2=None``: minimise γ² (Corollary 1); a number: feasibility at that
+    level with the largest margin; ``"free"``: the γ-free part (``gamma2`` of
+    the solution NaN, the certificate finds γ). With ``P`` normalised,
+    ``γ'² = γ²/(νρ)²`` is solved for, and ``R, S, Ā_F, B̄_F, λ`` come back
+    multiplied by ν², ``C̄_F`` by ν and γ² by (νρ)² (exact, powers of two);
+    the margin is the normalised problem's (its sign is what matters).
     """
     if not P.normalized:
-        return _solve_once(P, solver, margin, accuracy, gamma2, bound)
+        return problem.solve(solver, gamma2)
     g = P.nu * P.rho
     level = gamma2 if gamma2 is None or isinstance(gamma2, str) else float(gamma2) / g**2
-    sol = _solve_once(P, solver, margin, accuracy, level, bound)
-    if sol.R is None:
-        return dataclasses.replace(sol, gamma2=sol.gamma2 * g**2)
+    sol = problem.solve(solver, level)
     k = P.nu**2
-    return dataclasses.replace(
-        sol,
-        gamma2=sol.gamma2 * g**2,
-        R=sol.R * k,
-        S=sol.S * k,
-        Abar_F=sol.Abar_F * k,
-        Bbar_F=sol.Bbar_F * k,
-        Cbar_F=sol.Cbar_F * P.nu,
-        lam=sol.lam * k,
-    )
-
-
-def _solve_once(P, solver, margin, accuracy, gamma2, bound):
-    n, p = P.B.shape
-    m = P.C.shape[0]
-    q = P.D.shape[1]
-    l = P.L.shape[0]
-    observer = P.form == "observer"
-    # (variables created in the same order as before the observer option: identical general-form problems)
-    X = cp.Variable((n, n), symmetric=True)  # R in the general form, R − S in the observer form
-    S = cp.Variable((n, n), symmetric=True)
-    AbF = None if observer else cp.Variable((n, n))
-    BbF = cp.Variable((n, m))
-    CbF = None if observer else cp.Variable((l, n))
-    lam = cp.Variable() if P.H is not None else 0.0
-    if gamma2 is None:
-        g = cp.Variable()
-    elif isinstance(gamma2, str):
-        g = 0.0
-    else:
-        g = float(gamma2)
-    if observer:
-        R = X + S
-        M = observer_lmi_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, X, S, BbF, lam, g, bmat=cp.bmat)
-    else:
-        R = X
-        M = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, R, S, AbF, BbF, CbF, lam, g, bmat=cp.bmat)
-    if isinstance(gamma2, str):
-        keep = np.setdiff1d(np.arange(M.shape[0]), gamma_index(n, p, q))
-        M = M[keep, :][:, keep]
-    N = M.shape[0]
-    Msym = 0.5 * (M + M.T)
-    # R ≤ bound·I bounds every variable when (20) holds (S < R, ‖Ā_F‖² ≤ ‖R‖‖S‖, λ‖E‖² < ‖R‖, ...)
-    box = [R << bound * np.eye(n)]
-    if gamma2 is None:
-        t = margin
-        prob = cp.Problem(cp.Minimize(g), [Msym << -margin * np.eye(N)] + box)
-    else:
-        # the margin is capped: with a cap near the natural scale of (20) (its −I and −γ²I blocks) the
-        # solvers (CVXOPT above all) often fail or report "unbounded"
-        cap = 1e-3 * min(1.0, 1.0 if isinstance(gamma2, str) else float(gamma2))
-        t = cp.Variable()
-        prob = cp.Problem(cp.Maximize(t), [Msym << -t * np.eye(N), t <= cap] + box)
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        # a solver that cannot reach the requested accuracy (CVXOPT's residuals often stall near 1e-7 and it
-        # stops with a singular KKT matrix) is asked again with 100x looser tolerances
-        for acc in (accuracy, 100.0 * accuracy):
-            try:
-                prob.solve(solver=solver, **solver_kwargs(solver, acc))
-                break
-            except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-                error = exc  # CVXOPT raises ArithmeticError from inside LAPACK on near-singular steps
-        else:
-            return Solution(f"solver error ({error})", float("nan"), seconds=time.perf_counter() - start)
-    seconds = time.perf_counter() - start
-    status = str(prob.status)
-    if X.value is None or S.value is None:
-        return Solution(status, float("nan"), seconds=seconds)
-    sym = lambda Y: 0.5 * (Y + Y.T)
-    S_val = sym(S.value)
-    if observer:
-        R_val = S_val + sym(X.value)
-        Abar, Cbar = S_val @ P.A + BbF.value @ P.C, -P.L.copy()
-    else:
-        R_val = sym(X.value)
-        Abar, Cbar = AbF.value.copy(), CbF.value.copy()
-    if gamma2 is None:
-        gval = float(g.value)
-    elif isinstance(gamma2, str):
-        gval = float("nan")
-    else:
-        gval = float(gamma2)
-    tval = margin if gamma2 is None else float(t.value)
-    return Solution(
-        status,
-        gval,
-        R_val,
-        S_val,
-        Abar,
-        BbF.value.copy(),
-        Cbar,
-        float(lam.value) if P.H is not None else 0.0,
-        tval,
-        seconds,
-    )
-
-
+    values = {key: val * (P.nu if key == "Cbar_F" else k) for key, val in sol.values.items()}
+    return dataclasses.replace(sol, gamma2=sol.gamma2 * g**2, values=values)
