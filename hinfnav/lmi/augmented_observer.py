@@ -31,8 +31,6 @@ constant in time in the cell, hence in the polytope.
 
 from __future__ import annotations
 
-import time
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -40,8 +38,9 @@ import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .cells_general import read_cell_witness
 from .polytopic import extended_hinf_positive
-from .solve import solver_kwargs
+from .solve import solve_once
 
 __all__ = ["solve_augmented_observer"]
 
@@ -105,26 +104,7 @@ def solve_augmented_observer(cells: Sequence[Sequence[Sequence[ArrayLike]]], T: 
                 cons.append(P << bound * np.eye(N))
     if common is not None:
         cons.append(common << bound * np.eye(N))
-    if gamma2 is None:
-        prob = cp.Problem(cp.Minimize(g), cons)
-    else:
-        prob = cp.Problem(cp.Maximize(t), cons + [t <= 1e-3 * min(1.0, float(gamma2))])
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma2": float("nan"), "seconds": time.perf_counter() - start}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma2": float(g.value) if gamma2 is None and g.value is not None else (
-               float("nan") if gamma2 is None else float(gamma2))}
-    if G22.value is None or any(P.value is None for cell in Ps for P in cell):
-        return out
-    out["P"] = [[0.5 * (P.value + P.value.T) for P in cell] for cell in Ps]
-    out["G"] = [np.array(G.value) for G in Gs]
-    out["margin"] = margin if gamma2 is None else float(t.value)
-    if not np.linalg.cond(G22.value) < 1e14:
-        return out
-    out["B_F"] = np.linalg.solve(G22.value, Ghat.value)
+    out = solve_once(cons, g, solver, accuracy, t=t, gamma2=gamma2)
+    if read_cell_witness(out, G22, Ps, Gs, t) and np.linalg.cond(G22.value) < 1e14:
+        out["B_F"] = np.linalg.solve(G22.value, Ghat.value)
     return out

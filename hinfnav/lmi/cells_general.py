@@ -11,8 +11,6 @@ every cell certifies the bound for every α constant in time in each cell
 
 from __future__ import annotations
 
-import time
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -21,9 +19,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .polytopic import extended_hinf_positive, filter_slack_products
-from .solve import solver_kwargs
+from .solve import solve_once
 
-__all__ = ["solve_cells_general"]
+__all__ = ["solve_cells_general", "read_cell_witness"]
 
 
 def solve_cells_general(cells: Sequence[Sequence[Sequence[ArrayLike]]], lyapunov: str = "parameter-dependent",
@@ -34,7 +32,7 @@ def solve_cells_general(cells: Sequence[Sequence[Sequence[ArrayLike]]], lyapunov
     Returns
     -------
     dict
-        ``status``, ``gamma2``, ``seconds`` and, when solved, ``P`` (list of
+        ``status``, ``gamma2``, ``seconds`` (:func:`hinfnav.lmi.solve.solve_once`) and, when solved, ``P`` (list of
         lists), ``G`` (list, one per cell), ``A_F``, ``B_F``, ``C_F``, ``margin``.
     """
     A0, B0, C0, D0, L0 = (np.asarray(M, dtype=float) for M in cells[0][0])
@@ -59,24 +57,24 @@ def solve_cells_general(cells: Sequence[Sequence[Sequence[ArrayLike]]], lyapunov
                 cons.append(P << bound * np.eye(2 * n))
     if common is not None:
         cons.append(common << bound * np.eye(2 * n))
-    prob = cp.Problem(cp.Minimize(g), cons) if gamma2 is None else \
-        cp.Problem(cp.Maximize(t), cons + [t <= 1e-3 * min(1.0, float(gamma2))])
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma2": float("nan"), "seconds": time.perf_counter() - start}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma2": float(g.value) if gamma2 is None and g.value is not None else (
-               float("nan") if gamma2 is None else float(gamma2))}
-    if V.value is None or any(P.value is None for cell in Ps for P in cell):
-        return out
-    out["P"] = [[0.5 * (P.value + P.value.T) for P in cell] for cell in Ps]
-    out["G"] = [np.array(G.value) for G in Gs]
-    out["margin"] = margin if gamma2 is None else float(t.value)
-    if np.linalg.cond(V.value) < 1e14:
+    out = solve_once(cons, g, solver, accuracy, t=t, gamma2=gamma2)
+    if read_cell_witness(out, V, Ps, Gs, t) and np.linalg.cond(V.value) < 1e14:
         out["A_F"], out["B_F"] = np.linalg.solve(V.value, Ahat.value), np.linalg.solve(V.value, Bhat.value)
         out["C_F"] = np.array(CF.value)
     return out
+
+
+def read_cell_witness(out: dict[str, Any], key: cp.Variable, Ps: Sequence[Sequence[cp.Variable]],
+                      Gs: Sequence[Any], t: Any) -> bool:
+    """Add a solved cells problem's witness to ``out``: ``P`` (per cell, per vertex, symmetrised), ``G``, ``margin``.
+
+    ``key`` is the variable the filter is recovered from (its slack block);
+    ``t`` the margin, a number (minimisation) or the maximised cvxpy
+    variable. False (``out`` unchanged) when ``key`` or some ``Pᵢ`` has no value.
+    """
+    if key.value is None or any(P.value is None for cell in Ps for P in cell):
+        return False
+    out["P"] = [[0.5 * (P.value + P.value.T) for P in cell] for cell in Ps]
+    out["G"] = [np.array(G.value) for G in Gs]
+    out["margin"] = float(t.value) if isinstance(t, cp.Variable) else t
+    return True

@@ -33,8 +33,6 @@ the returned witness are negative definite.
 
 from __future__ import annotations
 
-import time
-import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -43,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..analysis.certificates import schur_gamma
-from .solve import solver_kwargs
+from .solve import solve_once_gamma
 
 __all__ = ["continuous_brl_matrix", "continuous_pd_matrix", "robust_hinf_continuous", "certify_continuous",
            "solve_continuous_observer"]
@@ -100,16 +98,7 @@ def robust_hinf_continuous(vertices: Sequence[Sequence[ArrayLike]], lyapunov: st
             cons.append(P >> margin * np.eye(n))
             M = continuous_pd_matrix(P, F, G, A, B, C, D, g, bmat=cp.bmat)
             cons.append(0.5 * (M + M.T) << -margin * np.eye(M.shape[0]))
-    prob = cp.Problem(cp.Minimize(g), cons)
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma": float("nan"), "seconds": time.perf_counter() - start}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma": float(np.sqrt(max(g.value, 0.0))) if g.value is not None else float("nan")}
+    out = solve_once_gamma(cons, g, solver, accuracy)
     if any(P.value is None for P in Ps):
         return out
     out["P"] = [0.5 * (P.value + P.value.T) for P in Ps]
@@ -177,16 +166,7 @@ def solve_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], T: ArrayL
             [Cb, Z((p, N)), Z((p, k)), -np.eye(p)],
         ])
         cons += [P >> margin * np.eye(N), 0.5 * (M + M.T) << -margin * np.eye(M.shape[0])]
-    prob = cp.Problem(cp.Minimize(g), cons)
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, accuracy))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma": float("nan"), "seconds": time.perf_counter() - start}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma": float(np.sqrt(max(g.value, 0.0))) if g.value is not None else float("nan")}
+    out = solve_once_gamma(cons, g, solver, accuracy)
     if F22.value is None or any(P.value is None for P in Ps) or not np.linalg.cond(F22.value) < 1e14:
         return out
     Fv = np.array(F.value)

@@ -29,8 +29,6 @@ returned coefficients of P, the smallest γ making each negative definite
 from __future__ import annotations
 
 import itertools
-import time
-import warnings
 from collections.abc import Callable, Sequence
 from math import comb
 from typing import Any
@@ -40,7 +38,7 @@ import numpy as np
 
 from ..analysis.certificates import schur_gamma
 from ..core.exceptions import InputError
-from .solve import solver_kwargs
+from .solve import solve_once_gamma
 
 __all__ = ["robust_hinf_box"]
 
@@ -145,16 +143,7 @@ def robust_hinf_box(plant: Callable[[np.ndarray], Sequence[Any]], ranges: Sequen
     for k, w in W.items():
         M = cp.bmat([[T11[k] + w * C.T @ C, T21[k].T + w * C.T @ D], [T21[k] + w * D.T @ C, w * (D.T @ D) - w * mu * np.eye(m)]])
         cons.append(0.5 * (M + M.T) << -margin * np.eye(n + m))
-    prob = cp.Problem(cp.Minimize(mu), cons)
-    start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            prob.solve(solver=solver, **solver_kwargs(solver, 1e-9))
-        except (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            return {"status": f"solver error ({exc})", "gamma": float("nan"), "certified": float("inf")}
-    out = {"status": str(prob.status), "seconds": time.perf_counter() - start,
-           "gamma": float(np.sqrt(max(mu.value, 0.0))) if mu.value is not None else float("nan")}
+    out = solve_once_gamma(cons, mu, solver, 1e-9)
     if any(P.value is None for P in Pv.values()):
         out["certified"] = float("inf")
         return out

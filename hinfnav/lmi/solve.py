@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from .conditioning import Prepared
 
 __all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
-           "run_solver", "lmi20_problem", "solve_lmi"]
+           "run_solver", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi"]
 
 #: Solvers the synthesis accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")
@@ -236,6 +236,44 @@ def run_solver(prob: cp.Problem, solver: str, accuracy: float | None = None, ret
             except SOLVER_ERRORS as exc:
                 error = exc
     return f"solver error ({error})", time.perf_counter() - start, len(tries)
+
+
+def solve_once(cons: list, level: Any, solver: str, accuracy: float | None, t: Any = None,
+               gamma2: float | None = None) -> dict[str, Any]:
+    """One :func:`run_solver` call (no retry) of a problem built in a single shot: minimise or maximise the margin.
+
+    ``gamma2=None``: minimise ``level`` (a cvxpy expression, γ²) subject to
+    ``cons``; otherwise maximise the margin variable ``t`` of ``cons`` at the
+    fixed level ``gamma2``, with ``t ≤ 1e-3·min(1, γ²)`` (as
+    :class:`LMIProblem`). The variables of ``cons`` hold the solution.
+
+    Returns
+    -------
+    dict
+        ``status`` (cvxpy's, or ``"solver error (...)"``), ``gamma2`` (the
+        solver's minimum, or ``gamma2``; NaN without a solution) and
+        ``seconds``.
+    """
+    if gamma2 is None:
+        prob = cp.Problem(cp.Minimize(level), cons)
+    else:
+        prob = cp.Problem(cp.Maximize(t), list(cons) + [t <= 1e-3 * min(1.0, float(gamma2))])
+    status, seconds, _ = run_solver(prob, solver, accuracy, retry=False)
+    if status.startswith("solver error"):
+        g2 = float("nan")
+    elif gamma2 is None:
+        g2 = float(level.value) if level.value is not None else float("nan")
+    else:
+        g2 = float(gamma2)
+    return {"status": status, "gamma2": g2, "seconds": seconds}
+
+
+def solve_once_gamma(cons: list, g2: Any, solver: str, accuracy: float | None) -> dict[str, Any]:
+    """:func:`solve_once` minimising γ² = ``g2``, reporting ``gamma`` = √max(γ², 0) (NaN without a solution)."""
+    out = solve_once(cons, g2, solver, accuracy)
+    level = out.pop("gamma2")
+    out["gamma"] = float(np.sqrt(max(level, 0.0))) if not math.isnan(level) else float("nan")
+    return out
 
 
 class LMIProblem:
