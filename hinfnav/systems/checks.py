@@ -36,6 +36,7 @@ from ..core.exceptions import ModelFunctionError
 
 __all__ = [
     "JACOBIAN_TOL",
+    "CheckedModel",
     "call_model",
     "check_jacobian_against_differences",
     "first_call_memo",
@@ -71,6 +72,26 @@ def first_call_memo(model):
     if memo is None:
         memo = model.__dict__["_first_call_memo"] = {}
     return memo
+
+
+class CheckedModel:
+    """Base of the model classes whose subclasses written outside hinfnav are checked at the door.
+
+    Such a subclass has the methods it defines itself and that :attr:`_method_checks` names wrapped
+    (:func:`wrap_user_methods`); :attr:`_first_calls` records which first-call checks have run.
+    """
+
+    #: method name → wrapper of a user subclass's own method (each model base class names its own)
+    _method_checks: dict = {}
+    #: tolerance of the first-call check of a user Jacobian against central differences (None: no check)
+    jacobian_tol = JACOBIAN_TOL
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        wrap_user_methods(cls, **cls._method_checks)
+
+    #: which first-call checks have run on this model (check name → True)
+    _first_calls = property(first_call_memo)
 
 
 def _where(t):

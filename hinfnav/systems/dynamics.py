@@ -39,13 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
-from .checks import (
-    JACOBIAN_TOL,
-    call_model,
-    check_jacobian_against_differences,
-    first_call_memo,
-    wrap_user_methods,
-)
+from .checks import JACOBIAN_TOL, CheckedModel, call_model, check_jacobian_against_differences
 from .state import StateSpec
 
 __all__ = [
@@ -160,7 +154,7 @@ def _checked_jacobian(raw):
     return jacobian
 
 
-class DynamicsModel:
+class DynamicsModel(CheckedModel):
     """Base class of the nonlinear dynamics models (see the module docstring).
 
     Parameters
@@ -177,16 +171,8 @@ class DynamicsModel:
     """
 
     linear = False
-    #: tolerance of the first-call check of a user Jacobian against central differences (None: no check)
-    jacobian_tol = JACOBIAN_TOL
-
-    def __init_subclass__(cls, **kwargs):
-        """A subclass written outside hinfnav has its ``f`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)."""
-        super().__init_subclass__(**kwargs)
-        wrap_user_methods(cls, f=_checked_f, jacobian=_checked_jacobian)
-
-    #: which first-call checks have run on this model (check name → True)
-    _first_calls = property(first_call_memo)
+    #: a subclass written outside hinfnav has its ``f`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)
+    _method_checks = {"f": _checked_f, "jacobian": _checked_jacobian}
 
     @property
     def _label(self):

@@ -26,13 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_positive
-from .checks import (
-    JACOBIAN_TOL,
-    call_model,
-    check_jacobian_against_differences,
-    first_call_memo,
-    wrap_user_methods,
-)
+from .checks import CheckedModel, call_model, check_jacobian_against_differences
 from .dynamics import finite_difference_jacobian
 
 __all__ = [
@@ -81,7 +75,7 @@ def _checked_measurement_jacobian(raw):
     return jacobian
 
 
-class MeasurementModel:
+class MeasurementModel(CheckedModel):
     """Base class: ``y = h(x) + D v`` with unit-variance white v.
 
     Attributes
@@ -97,16 +91,8 @@ class MeasurementModel:
 
     linear = False
     H = None
-    #: tolerance of the first-call check of a user subclass's ``jacobian`` against differences of ``function``
-    jacobian_tol = JACOBIAN_TOL
-
-    def __init_subclass__(cls, **kwargs):
-        """A subclass written outside hinfnav has ``function`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)."""
-        super().__init_subclass__(**kwargs)
-        wrap_user_methods(cls, function=_checked_function, jacobian=_checked_measurement_jacobian)
-
-    #: which first-call checks have run on this model (check name → True)
-    _first_calls = property(first_call_memo)
+    #: a subclass written outside hinfnav has ``function`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)
+    _method_checks = {"function": _checked_function, "jacobian": _checked_measurement_jacobian}
 
     @property
     def _label(self):
