@@ -32,16 +32,18 @@ import sys
 import warnings
 from typing import TYPE_CHECKING
 
-from .core.lazy import lazy_exports
+from .core.lazy import exported_from, lazy_exports
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .core import (
         CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
         UnstablePlantError,
     )
-    from .core import (
-        CampaignTruthScenario, DesignResultProtocol, DynamicsProtocol, EstimatorHooks, MeasurementProtocol,
-        OwnTruthScenario, ScenarioProtocol, TruthModelProtocol,
+    from .core.protocols import (  # "X as X": re-exported, their __all__ entries read from this block
+        CampaignTruthScenario as CampaignTruthScenario, DesignResultProtocol as DesignResultProtocol,
+        DynamicsProtocol as DynamicsProtocol, EstimatorHooks as EstimatorHooks,
+        MeasurementProtocol as MeasurementProtocol, OwnTruthScenario as OwnTruthScenario,
+        ScenarioProtocol as ScenarioProtocol, TruthModelProtocol as TruthModelProtocol,
     )
     from .systems import (
         hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
@@ -187,14 +189,7 @@ __all__ = [
     "monte_carlo_summary",
     "monte_carlo_statistics",
     # protocols (hinfnav.core.protocols): what your own scenario, system, sensor, filter, design offer
-    "ScenarioProtocol",
-    "OwnTruthScenario",
-    "CampaignTruthScenario",
-    "TruthModelProtocol",
-    "DynamicsProtocol",
-    "MeasurementProtocol",
-    "EstimatorHooks",
-    "DesignResultProtocol",
+    *exported_from(__name__, ".core.protocols"),
     # errors
     "HinfnavError",
     "InputError",

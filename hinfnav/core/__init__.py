@@ -18,15 +18,19 @@ from .exceptions import (
     SynthesisError,
     UnstablePlantError,
 )
-from .lazy import lazy_exports
+from .lazy import exported_from, lazy_exports
 from .validation import as_choice, as_int_at_least, as_matrix, as_nonnegative, as_positive, as_real, as_vector
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .linalg import as_covariance, discretize, spectral_radius, sym
-    from .protocols import (
-        CampaignTruthScenario, DesignResultProtocol, DynamicsProtocol, EstimatorHooks, MeasurementProtocol,
-        OwnTruthScenario, ScenarioProtocol, TruthModelProtocol,
+    from .protocols import (  # "X as X": re-exported, their __all__ entries read from this block
+        CampaignTruthScenario as CampaignTruthScenario, DesignResultProtocol as DesignResultProtocol,
+        DynamicsProtocol as DynamicsProtocol, EstimatorHooks as EstimatorHooks,
+        MeasurementProtocol as MeasurementProtocol, OwnTruthScenario as OwnTruthScenario,
+        ScenarioProtocol as ScenarioProtocol, TruthModelProtocol as TruthModelProtocol,
     )
+
+__getattr__, __dir__ = lazy_exports(__name__)
 
 __all__ = [
     "HinfnavError",
@@ -48,14 +52,5 @@ __all__ = [
     "spectral_radius",
     "sym",
     "discretize",
-    "ScenarioProtocol",
-    "OwnTruthScenario",
-    "CampaignTruthScenario",
-    "TruthModelProtocol",
-    "DynamicsProtocol",
-    "MeasurementProtocol",
-    "EstimatorHooks",
-    "DesignResultProtocol",
+    *exported_from(__name__, ".protocols"),
 ]
-
-__getattr__, __dir__ = lazy_exports(__name__)

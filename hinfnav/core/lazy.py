@@ -35,7 +35,7 @@ from pathlib import Path
 
 from .exceptions import HinfnavError
 
-__all__ = ["lazy_exports", "type_checking_imports"]
+__all__ = ["exported_from", "lazy_exports", "type_checking_imports"]
 
 
 def type_checking_imports(path: str | Path) -> dict[str, str]:
@@ -114,3 +114,30 @@ def lazy_exports(package: str) -> tuple[Callable[[str], object], Callable[[], li
         return sorted(set(vars(module)) | set(exports))
 
     return __getattr__, __dir__
+
+
+def exported_from(package: str, source: str) -> list[str]:
+    """The names a lazy package exports from ``source``, in the order its ``if TYPE_CHECKING:`` block lists them.
+
+    Lets a package's ``__all__`` take a group of names from its export table instead of typing them a
+    second time: ``__all__ = [..., *exported_from(__name__, ".protocols")]``.
+
+    Parameters
+    ----------
+    package : str
+        The package's ``__name__``; :func:`lazy_exports` must have run for it.
+    source : str
+        The module the names are imported from, relative as written in the block (``".protocols"``).
+
+    Raises
+    ------
+    HinfnavError
+        The package has no export table, or imports nothing from ``source``.
+    """
+    exports = getattr(sys.modules[package], "_EXPORTS", None)
+    if exports is None:
+        raise HinfnavError(f"{package}: call lazy_exports(__name__) before exported_from")
+    names = [name for name, module in exports.items() if module == source]
+    if not names:
+        raise HinfnavError(f"{package}: its TYPE_CHECKING block imports nothing from {source!r}")
+    return names

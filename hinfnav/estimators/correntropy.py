@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
 from .correction import joseph_covariance
 from .kalman import ExtendedKalmanFilter
-from .variational import _from_ekf, _reference, _swap, relative_change
+from .variational import DataDependentCorrection, _from_ekf, _prior_per_run, _swap, relative_change
 
 if TYPE_CHECKING:
     from .base import FilterState
@@ -55,14 +55,12 @@ __all__ = ["CorrentropyCorrection", "CorrentropyFilter", "WEIGHT_FLOOR"]
 WEIGHT_FLOOR = 1e-100
 
 
-class CorrentropyCorrection:
+class CorrentropyCorrection(DataDependentCorrection):
     """Mixin: the maximum-correntropy correction (Chen et al. 2017) on a filter of the Kalman core.
 
     Keyword parameters ``sigma`` (kernel bandwidth σ on the whitened residuals, > 0),
     ``tol`` ε (≥ 0) and ``max_iter`` (≥ 1). See the module docstring.
     """
-
-    data_dependent_covariance = True
 
     def __init__(self, *args: Any, sigma: float = 2.0, tol: float = 1e-6, max_iter: int = 100, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -70,20 +68,12 @@ class CorrentropyCorrection:
         self.tol = as_nonnegative("tol", tol)
         self.max_iter = as_int_at_least("max_iter", max_iter, 1)
 
-    @property
-    def shares_covariance(self) -> bool:
-        """Always False: the kernel weights, hence P, depend on the data."""
-        return False
-
     def correct(self, x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64],
                 innovation: NDArray[np.float64], state: FilterState,
                 R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
-        """The fixed point of the module docstring; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
+        """The kernel-weighted fixed point of the module docstring; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
         R = self.R if R is None else R
-        runs = innovation.shape[0]
-        P = np.broadcast_to(P, (runs,) + P.shape[-2:])
-        n = P.shape[-1]
-        x_ref = _reference(x, P)
+        runs, P, n, x_ref = _prior_per_run(x, P, innovation)
         Bp = np.linalg.cholesky(P)
         Br = np.linalg.cholesky(R)
         HT = _swap(H)

@@ -35,8 +35,9 @@ from ..core.validation import as_int_at_least
 from ..systems.linear import LinearSystem
 from ..systems.measurements import LinearMeasurement
 from ..systems.state import StateSpec
-from .base import EstimateHistory, check_estimator_inputs
+from .base import EstimateHistory
 from .recursive_hinf import RecursiveHInfinityFilter
+from .smoothers import record_inputs
 
 __all__ = ["hinf_fixed_lag"]
 
@@ -87,15 +88,7 @@ def hinf_fixed_lag(estimator: RecursiveHInfinityFilter, y: ArrayLike, u: ArrayLi
     if not isinstance(estimator, RecursiveHInfinityFilter):
         raise InputError(f"estimator must be a RecursiveHInfinityFilter; got {type(estimator).__name__}")
     lag = as_int_at_least("lag", lag, 0)
-    y = np.asarray(y, dtype=float)
-    if y.ndim != 3:
-        raise InputError(f"y must have shape (runs, n_samples, n_meas); got {y.shape}")
-    if u is None:
-        if estimator.uses_input:
-            raise InputError(f"filter {estimator.name!r} uses the applied input: u is needed")
-        u = np.zeros(y.shape[:2] + (estimator.Gamma.shape[1],))
-    y, u, x0 = check_estimator_inputs(y, u, xhat0, estimator.n_state, estimator.measurement.n_meas,
-                                      estimator.n_input if estimator.uses_input else None, estimator.missing)
+    y, u, x0 = record_inputs(estimator, y, u, xhat0, u_width=estimator.Gamma.shape[1])
     runs, N, _ = y.shape
     n, b = estimator.n_state, lag + 2
     aug = _augmented(estimator, lag)

@@ -236,6 +236,27 @@ class SigmaPointFilter(GateOption, Estimator):
             x = self._inject(x, np.zeros((runs, self.n_cov)))
         return FilterState(x=x, P=np.broadcast_to(P, (runs,) + P.shape).copy())
 
+    def _predicted_outputs(self, X, x, k):
+        """``(ȳ, dY)``: the weighted mean (runs, m) of h at the sigma points X (runs, N, n) and their deviations.
+
+        The mean is taken about ``h(x̂⁻)`` (the first point for the unscented rule). A measurement function
+        that refuses a point (InputError) stops the filter with a HinfnavError naming step ``k``.
+        """
+        runs, N, n = X.shape
+        try:
+            Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
+            ref = Y[:, 0] if self.rule == "unscented" else self.measurement.function(x)  # h(x̂⁻)
+        except ModelFunctionError:  # a user model's own error, already naming its function
+            raise
+        except InputError as exc:
+            raise HinfnavError(f"filter {self.name!r} stopped at step {k}: a sigma point reached a singular "
+                               f"point of the measurement ({exc})") from None
+        # differences of predicted outputs: the model's residual (angles wrapped), except for a converted
+        # measurement, whose residual converts a reading (its predicted outputs are positions: plain differences)
+        diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
+        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
+        return y_mean, diff(Y, y_mean[:, None, :])
+
     def _update(self, state, y):
         x, P = state.x, state.P
         runs, n = x.shape
@@ -245,20 +266,7 @@ class SigmaPointFilter(GateOption, Estimator):
             P = gate.inflate(P, count)
         dX = self._points(P, state.k, "prior")
         X = self._inject(x[:, None, :], dX)
-        N = X.shape[1]
-        try:
-            Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
-            ref = Y[:, 0] if self.rule == "unscented" else self.measurement.function(x)  # h(x̂⁻)
-        except ModelFunctionError:  # a user model's own error, already naming its function
-            raise
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: a sigma point reached a singular "
-                               f"point of the measurement ({exc})") from None
-        # differences of predicted outputs: the model's residual (angles wrapped), except for a converted
-        # measurement, whose residual converts a reading (its predicted outputs are positions: plain differences)
-        diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
-        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
-        dY = diff(Y, y_mean[:, None, :])
+        y_mean, dY = self._predicted_outputs(X, x, state.k)
         y, mask = fill_missing(self.measurement, y, x, y_mean, mask)  # a missing channel reads as predicted
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
         innovation = self.measurement.residual(y, y_mean)

@@ -64,7 +64,7 @@ from .lti import LTIFilter
 from .recursive_hinf import ExtendedHInfinityFilter, RecursiveHInfinityFilter
 from .sigma_point import SigmaPointFilter
 
-__all__ = ["FilterRecord", "SmoothedHistory", "filter_record", "rts_smooth", "smooth", "filter_smoother_consistency"]
+__all__ = ["FilterRecord", "SmoothedHistory", "filter_record", "record_inputs", "rts_smooth", "smooth", "filter_smoother_consistency"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,6 +195,24 @@ def _cross_covariance(est: Estimator, state: Any, u: NDArray[np.float64] | None)
     return P @ est.F.T
 
 
+def record_inputs(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike,
+                  u_width: int = 0) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(y, u, x̂₀)`` of a routine over whole records (a smoother), checked by :func:`check_estimator_inputs`.
+
+    ``u`` may be None for a filter that does not use its input: then it is zeros (runs, N, ``u_width``).
+    Raises InputError for y not (runs, N, m), or for u None when the filter uses it.
+    """
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 3:
+        raise InputError(f"y must have shape (runs, n_samples, n_meas); got {y.shape}")
+    if u is None:
+        if estimator.uses_input:
+            raise InputError(f"filter {estimator.name!r} uses the applied input: u is needed")
+        u = np.zeros(y.shape[:2] + (u_width,))
+    return check_estimator_inputs(y, u, xhat0, estimator.n_state, estimator.measurement.n_meas,
+                                  estimator.n_input if estimator.uses_input else None, estimator.missing)
+
+
 def filter_record(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0: ArrayLike,
                   P0: ArrayLike | None = None, *, predictor: Callable[[int], Estimator] | None = None) -> FilterRecord:
     """Run a Gaussian filter forward over (runs, N, m) readings and record what (S1)–(S3) need.
@@ -206,15 +224,7 @@ def filter_record(estimator: Estimator, y: ArrayLike, u: ArrayLike | None, xhat0
     Raises InputError for a filter with no smoother (see the module docstring).
     """
     _refuse(estimator)
-    y_arr = np.asarray(y, dtype=float)
-    if y_arr.ndim != 3:
-        raise InputError(f"y must have shape (runs, n_samples, n_meas); got {y_arr.shape}")
-    if u is None:
-        if estimator.uses_input:
-            raise InputError(f"filter {estimator.name!r} uses the applied input: u is needed")
-        u = np.zeros(y_arr.shape[:2] + (0,))
-    y_arr, u, x0 = check_estimator_inputs(y_arr, u, xhat0, estimator.n_state, estimator.measurement.n_meas,
-                                          estimator.n_input if estimator.uses_input else None, estimator.missing)
+    y_arr, u, x0 = record_inputs(estimator, y, u, xhat0)
     runs, N, _ = y_arr.shape
     state = estimator.start(x0, P0, runs)
     xf, Pf, xp, Pp, C = [], [], [state.x], [state.P], []

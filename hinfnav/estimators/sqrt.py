@@ -261,16 +261,7 @@ class SquareRootSigmaPointFilter(SigmaPointFilter):
         mask = available_channels(y) if self.missing == "skip" else None
         dX = self._offsets(S)
         X = x[:, None, :] + dX
-        N = X.shape[1]
-        try:
-            Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
-            ref = Y[:, 0] if self.rule == "unscented" else self.measurement.function(x)
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: a sigma point reached a singular "
-                               f"point of the measurement ({exc})") from None
-        diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
-        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
-        dY = diff(Y, y_mean[:, None, :])
+        y_mean, dY = self._predicted_outputs(X, x, state.k)
         y, mask = fill_missing(self.measurement, y, x, y_mean, mask)
         R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
         nu = self.measurement.residual(y, y_mean)

@@ -77,8 +77,8 @@ from .kalman import ExtendedKalmanFilter
 if TYPE_CHECKING:
     from .base import FilterState
 
-__all__ = ["StudentTCorrection", "StudentTFilter", "NoiseAdaptiveCorrection", "NoiseAdaptiveFilter",
-           "used_rows", "relative_change"]
+__all__ = ["DataDependentCorrection", "StudentTCorrection", "StudentTFilter", "NoiseAdaptiveCorrection",
+           "NoiseAdaptiveFilter", "used_rows", "relative_change"]
 
 
 def _swap(M):
@@ -107,15 +107,31 @@ def _reference(x, P):
     return x if x.shape[-1] == P.shape[-1] else None
 
 
-class StudentTCorrection:
+def _prior_per_run(x, P, innovation):
+    """``(runs, P, n, x_ref)`` of an iterated correction: P broadcast to (runs, n, n), the stopping rule's reference."""
+    runs = innovation.shape[0]
+    P = np.broadcast_to(P, (runs,) + P.shape[-2:])
+    return runs, P, P.shape[-1], _reference(x, P)
+
+
+class DataDependentCorrection:
+    """Mixin base of a correction whose weights or noise estimates, hence P, depend on the data."""
+
+    data_dependent_covariance = True
+
+    @property
+    def shares_covariance(self) -> bool:
+        """Always False: the correction's weights or noise estimates, hence P, depend on the data."""
+        return False
+
+
+class StudentTCorrection(DataDependentCorrection):
     """Mixin: Huang et al. (2017)'s variational Student-t update as the correction of a Kalman-type filter.
 
     Put it first in the bases of a filter of the Kalman core. Keyword parameters
     ``dof_process`` ω, ``dof_measurement`` ν (> 0), ``iterations`` N (≥ 1) and ``tol`` τ
     (≥ 0; 0: always N iterations). See the module docstring.
     """
-
-    data_dependent_covariance = True
 
     def __init__(self, *args: Any, dof_process: float = 5.0, dof_measurement: float = 5.0, iterations: int = 10,
                  tol: float = 1e-8, **kwargs: Any) -> None:
@@ -125,21 +141,13 @@ class StudentTCorrection:
         self.iterations = as_int_at_least("iterations", iterations, 1)
         self.tol = as_nonnegative("tol", tol)
 
-    @property
-    def shares_covariance(self) -> bool:
-        """Always False: the scales E[ξ], E[λ], hence P, depend on the data."""
-        return False
-
     def correct(self, x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64],
                 innovation: NDArray[np.float64], state: FilterState,
                 R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
-        """The fixed point of the module docstring; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
+        """The variational fixed point of the module docstring; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
         R = self.R if R is None else R
-        runs = innovation.shape[0]
-        P = np.broadcast_to(P, (runs,) + P.shape[-2:])
-        n = P.shape[-1]
+        runs, P, n, x_ref = _prior_per_run(x, P, innovation)
         m_used = used_rows(H, runs).sum(axis=1)
-        x_ref = _reference(x, P)
         Pinv = np.linalg.inv(P)
         Rinv = np.linalg.inv(R)
         HT = _swap(H)
@@ -212,7 +220,7 @@ def _from_ekf(cls, ekf, name, options):
                output=ekf.output, name=name, missing=ekf.missing, **options)
 
 
-class NoiseAdaptiveCorrection:
+class NoiseAdaptiveCorrection(DataDependentCorrection):
     """Mixin: Särkkä & Nummenmaa (2009)'s variational-Bayes update with an unknown diagonal R.
 
     Keyword parameters ``rho`` ρ ∈ (0, 1] (the fading of α, β between readings),
@@ -220,8 +228,6 @@ class NoiseAdaptiveCorrection:
     ``alpha0 · diag(R)``). The posterior α, β are carried from reading to reading in
     ``FilterState.extra`` (keys ``vb_alpha``, ``vb_beta``; the core's :meth:`carried` hook).
     """
-
-    data_dependent_covariance = True
 
     def __init__(self, *args: Any, rho: float = 1.0, iterations: int = 5, alpha0: float = 1.0,
                  beta0: ArrayLike | None = None, **kwargs: Any) -> None:
@@ -239,11 +245,6 @@ class NoiseAdaptiveCorrection:
         if beta0.shape != (m,) or not np.all(np.isfinite(beta0)) or np.any(beta0 <= 0):
             raise InputError(f"beta0 must be {m} positive finite numbers (one per channel); got {beta0!r}")
         self.beta0 = beta0
-
-    @property
-    def shares_covariance(self) -> bool:
-        """Always False: the estimated noise, hence P, depends on the data."""
-        return False
 
     def carried(self, diagnostics: dict[str, Any]) -> dict[str, Any]:
         """α, β of this reading, kept for the next."""

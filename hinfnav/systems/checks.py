@@ -34,7 +34,15 @@ import numpy as np
 
 from ..core.exceptions import ModelFunctionError
 
-__all__ = ["JACOBIAN_TOL", "call_model", "check_jacobian_against_differences", "is_user_class"]
+__all__ = [
+    "JACOBIAN_TOL",
+    "CheckedModel",
+    "call_model",
+    "check_jacobian_against_differences",
+    "first_call_memo",
+    "is_user_class",
+    "wrap_user_methods",
+]
 
 #: Default tolerance of the first-call Jacobian check (relative to max(1, max |J_fd|)).
 JACOBIAN_TOL = 1e-4
@@ -43,6 +51,47 @@ JACOBIAN_TOL = 1e-4
 def is_user_class(cls):
     """True for a class written outside the hinfnav package (its functions are the user's, checked)."""
     return not str(getattr(cls, "__module__", "")).startswith("hinfnav.")
+
+
+def wrap_user_methods(cls, **wrappers):
+    """Wrap the methods a user class defines itself: ``name=wrapper`` replaces ``cls.name`` by ``wrapper(cls.name)``.
+
+    Called from the ``__init_subclass__`` of the model base classes; a class inside hinfnav is left as it is,
+    and so is a method the class inherits (it was checked, or trusted, where it was defined).
+    """
+    if not is_user_class(cls):
+        return
+    for name, wrapper in wrappers.items():
+        if name in cls.__dict__:
+            setattr(cls, name, wrapper(cls.__dict__[name]))
+
+
+def first_call_memo(model):
+    """Which first-call checks have run on ``model`` (check name → True); the ``state`` of :func:`call_model`."""
+    memo = model.__dict__.get("_first_call_memo")
+    if memo is None:
+        memo = model.__dict__["_first_call_memo"] = {}
+    return memo
+
+
+class CheckedModel:
+    """Base of the model classes whose subclasses written outside hinfnav are checked at the door.
+
+    Such a subclass has the methods it defines itself and that :attr:`_method_checks` names wrapped
+    (:func:`wrap_user_methods`); :attr:`_first_calls` records which first-call checks have run.
+    """
+
+    #: method name → wrapper of a user subclass's own method (each model base class names its own)
+    _method_checks: dict = {}
+    #: tolerance of the first-call check of a user Jacobian against central differences (None: no check)
+    jacobian_tol = JACOBIAN_TOL
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        wrap_user_methods(cls, **cls._method_checks)
+
+    #: which first-call checks have run on this model (check name → True)
+    _first_calls = property(first_call_memo)
 
 
 def _where(t):

@@ -39,7 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
-from .checks import JACOBIAN_TOL, call_model, check_jacobian_against_differences, is_user_class
+from .checks import JACOBIAN_TOL, CheckedModel, call_model, check_jacobian_against_differences
 from .state import StateSpec
 
 __all__ = [
@@ -128,7 +128,33 @@ def rk4_step(a, x, u, t, h, A=None):
     return x_next, eye + h / 6.0 * (K1 + 2.0 * K2 + 2.0 * K3 + K4)
 
 
-class DynamicsModel:
+def _checked_f(raw):
+    """A user subclass's ``f`` called through :func:`~hinfnav.systems.checks.call_model`."""
+
+    @functools.wraps(raw)
+    def f(self, x, u=None, t=0.0):
+        x, u, t = self.check(x, u, t)
+        return call_model(self._label, "f(x, u, t)", functools.partial(raw, self), x, (u, t), out_tail=(self.n,),
+                          t=t, state=self._first_calls)
+
+    return f
+
+
+def _checked_jacobian(raw):
+    """A user subclass's ``jacobian``: checked, and compared with differences of f on its first call."""
+
+    @functools.wraps(raw)
+    def jacobian(self, x, u=None, t=0.0):
+        x, u, t = self.check(x, u, t)
+        J = call_model(self._label, "jacobian(x, u, t)", functools.partial(raw, self), x, (u, t),
+                       out_tail=(self.n, self.n), t=t, allow_shared=True, state=self._first_calls)
+        self._check_jacobian_once(J, x, u, t, "jacobian(x, u, t)", self.f, "f")
+        return np.broadcast_to(J, (x.shape[0], self.n, self.n))
+
+    return jacobian
+
+
+class DynamicsModel(CheckedModel):
     """Base class of the nonlinear dynamics models (see the module docstring).
 
     Parameters
@@ -145,26 +171,8 @@ class DynamicsModel:
     """
 
     linear = False
-    #: tolerance of the first-call check of a user Jacobian against central differences (None: no check)
-    jacobian_tol = JACOBIAN_TOL
-
-    def __init_subclass__(cls, **kwargs):
-        """A subclass written outside hinfnav has its ``f`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)."""
-        super().__init_subclass__(**kwargs)
-        if not is_user_class(cls):
-            return
-        if "f" in cls.__dict__:
-            cls.f = _checked_f(cls.__dict__["f"])
-        if "jacobian" in cls.__dict__:
-            cls.jacobian = _checked_jacobian(cls.__dict__["jacobian"])
-
-    @property
-    def _first_calls(self):
-        """Which first-call checks have run on this model (function name → True)."""
-        memo = self.__dict__.get("_first_call_memo")
-        if memo is None:
-            memo = self.__dict__["_first_call_memo"] = {}
-        return memo
+    #: a subclass written outside hinfnav has its ``f`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)
+    _method_checks = {"f": _checked_f, "jacobian": _checked_jacobian}
 
     @property
     def _label(self):
@@ -472,29 +480,3 @@ class ConstantTurn(DynamicsModel):
         J[:, 2, 2], J[:, 2, 3], J[:, 2, 4] = cw, -sw, -T * (sw * vx + cw * vy)
         J[:, 3, 2], J[:, 3, 3], J[:, 3, 4] = sw, cw, T * (cw * vx - sw * vy)
         return J
-
-
-def _checked_f(raw):
-    """A user subclass's ``f`` called through :func:`~hinfnav.systems.checks.call_model`."""
-
-    @functools.wraps(raw)
-    def f(self, x, u=None, t=0.0):
-        x, u, t = self.check(x, u, t)
-        return call_model(self._label, "f(x, u, t)", functools.partial(raw, self), x, (u, t), out_tail=(self.n,),
-                          t=t, state=self._first_calls)
-
-    return f
-
-
-def _checked_jacobian(raw):
-    """A user subclass's ``jacobian``: checked, and compared with differences of f on its first call."""
-
-    @functools.wraps(raw)
-    def jacobian(self, x, u=None, t=0.0):
-        x, u, t = self.check(x, u, t)
-        J = call_model(self._label, "jacobian(x, u, t)", functools.partial(raw, self), x, (u, t),
-                       out_tail=(self.n, self.n), t=t, allow_shared=True, state=self._first_calls)
-        self._check_jacobian_once(J, x, u, t, "jacobian(x, u, t)", self.f, "f")
-        return np.broadcast_to(J, (x.shape[0], self.n, self.n))
-
-    return jacobian

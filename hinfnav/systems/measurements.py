@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_positive
-from .checks import JACOBIAN_TOL, call_model, check_jacobian_against_differences, is_user_class
+from .checks import CheckedModel, call_model, check_jacobian_against_differences
 from .dynamics import finite_difference_jacobian
 
 __all__ = [
@@ -43,7 +43,39 @@ __all__ = [
 ]
 
 
-class MeasurementModel:
+def _checked_function(raw):
+    """A user subclass's ``h(x)``: called on a (N, n) batch (a copy), shape and finiteness checked."""
+
+    @functools.wraps(raw)
+    def function(self, x):
+        xb, lead = _flat_states(self, x)
+        out = call_model(self._label, "function h(x)", functools.partial(raw, self), xb, out_tail=(self.n_meas,),
+                         state=self._first_calls)
+        return out.reshape(lead + (self.n_meas,))
+
+    return function
+
+
+def _checked_measurement_jacobian(raw):
+    """A user subclass's ``∂h/∂x``: checked, and compared with differences of h on its first call."""
+
+    @functools.wraps(raw)
+    def jacobian(self, x):
+        xb, lead = _flat_states(self, x)
+        shape = (self.n_meas, self.n_state)
+        J = call_model(self._label, "jacobian(x)", functools.partial(raw, self), xb, out_tail=shape,
+                       allow_shared=True, state=self._first_calls)
+        if self.jacobian_tol is not None and not self._first_calls.get("differences"):
+            fd = finite_difference_jacobian(lambda z, u, t: self.function(z), xb[:1])[0]
+            check_jacobian_against_differences(self._label, "jacobian(x)", J if J.ndim == 2 else J[0],
+                                               "function h", fd, self.jacobian_tol)
+            self._first_calls["differences"] = True
+        return np.broadcast_to(J, (xb.shape[0],) + shape).reshape(lead + shape)
+
+    return jacobian
+
+
+class MeasurementModel(CheckedModel):
     """Base class: ``y = h(x) + D v`` with unit-variance white v.
 
     Attributes
@@ -59,25 +91,8 @@ class MeasurementModel:
 
     linear = False
     H = None
-    #: tolerance of the first-call check of a user subclass's ``jacobian`` against differences of ``function``
-    jacobian_tol = JACOBIAN_TOL
-
-    def __init_subclass__(cls, **kwargs):
-        """A subclass written outside hinfnav has ``function`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)."""
-        super().__init_subclass__(**kwargs)
-        if not is_user_class(cls):
-            return
-        if "function" in cls.__dict__:
-            cls.function = _checked_function(cls.__dict__["function"])
-        if "jacobian" in cls.__dict__:
-            cls.jacobian = _checked_measurement_jacobian(cls.__dict__["jacobian"])
-
-    @property
-    def _first_calls(self):
-        memo = self.__dict__.get("_first_call_memo")
-        if memo is None:
-            memo = self.__dict__["_first_call_memo"] = {}
-        return memo
+    #: a subclass written outside hinfnav has ``function`` and ``jacobian`` checked (:mod:`hinfnav.systems.checks`)
+    _method_checks = {"function": _checked_function, "jacobian": _checked_measurement_jacobian}
 
     @property
     def _label(self):
@@ -521,35 +536,3 @@ def _flat_states(model, x):
     if not np.all(np.isfinite(x)):
         raise InputError(f"{model._label}: x must contain only finite numbers; it has NaN or inf entries")
     return x.reshape(-1, model.n_state), x.shape[:-1]
-
-
-def _checked_function(raw):
-    """A user subclass's ``h(x)``: called on a (N, n) batch (a copy), shape and finiteness checked."""
-
-    @functools.wraps(raw)
-    def function(self, x):
-        xb, lead = _flat_states(self, x)
-        out = call_model(self._label, "function h(x)", functools.partial(raw, self), xb, out_tail=(self.n_meas,),
-                         state=self._first_calls)
-        return out.reshape(lead + (self.n_meas,))
-
-    return function
-
-
-def _checked_measurement_jacobian(raw):
-    """A user subclass's ``∂h/∂x``: checked, and compared with differences of h on its first call."""
-
-    @functools.wraps(raw)
-    def jacobian(self, x):
-        xb, lead = _flat_states(self, x)
-        shape = (self.n_meas, self.n_state)
-        J = call_model(self._label, "jacobian(x)", functools.partial(raw, self), xb, out_tail=shape,
-                       allow_shared=True, state=self._first_calls)
-        if self.jacobian_tol is not None and not self._first_calls.get("differences"):
-            fd = finite_difference_jacobian(lambda z, u, t: self.function(z), xb[:1])[0]
-            check_jacobian_against_differences(self._label, "jacobian(x)", J if J.ndim == 2 else J[0],
-                                               "function h", fd, self.jacobian_tol)
-            self._first_calls["differences"] = True
-        return np.broadcast_to(J, (xb.shape[0],) + shape).reshape(lead + shape)
-
-    return jacobian
