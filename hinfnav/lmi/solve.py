@@ -298,7 +298,7 @@ class LMIProblem:
     ``calls`` counts every solver invocation of the problem.
     """
 
-    def __init__(self, build: Any, margin: float = 1e-8, accuracy: float | None = 1e-8, retry: bool = True):
+    def __init__(self, build: Any, margin: float = 1e-8, accuracy: float | None = 1e-8, retry: bool = True) -> None:
         self._build, self.margin, self.accuracy, self.retry = build, margin, accuracy, retry
         self._problems: dict = {}
         self.calls = 0
