@@ -186,9 +186,12 @@ def why_numpy(est: Any, diagnostics: set | bool | None = frozenset()) -> str | N
     elif diagnostics is False:
         diagnostics = frozenset()
     reason = kernel_status(est)
-    if reason is None and (diagnostics is None or not set(diagnostics) <= set(NIS_DIAGNOSTICS)):
+    extra = None if diagnostics is None else set(diagnostics) - set(NIS_DIAGNOSTICS)
+    if extra and getattr(est, "gate", None) is None:  # an ungated filter reports no gate diagnostics (a campaign
+        extra = {name for name in extra if not name.startswith("gate_")}  # asks every filter for them)
+    if reason is None and (extra is None or extra):
         reason = (f"diagnostics other than {', '.join(NIS_DIAGNOSTICS)} are computed on the NumPy path only (asked: "
-                  f"{'all' if diagnostics is None else ', '.join(sorted(set(diagnostics) - set(NIS_DIAGNOSTICS)))})")
+                  f"{'all' if extra is None else ', '.join(sorted(extra))})")
     if reason is None and not numba_available():
         reason = "numba is not installed (pip install numba==0.68.1)"
     return reason

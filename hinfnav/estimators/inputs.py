@@ -13,7 +13,7 @@ from ..core.validation import as_vector
 
 __all__ = ["READING_LIMIT", "KNOWN_DIAGNOSTICS", "initial_estimates", "check_reading_size"]
 
-#: Largest |reading| a filter accepts: beyond it a squared innovation (an innovation moment, a Huber weight, a
+#: Largest magnitude of a reading a filter accepts: beyond it a squared innovation (an innovation moment, a Huber weight, a
 #: converted range) overflows double precision, and the NumPy and compiled paths would fail differently.
 READING_LIMIT = 1e150
 

@@ -31,7 +31,7 @@ its posterior equal to its prior, which (S1)–(S3) then smooth.
 test of ODTK): under the filter's model, ``x̂(k|k) − x̂ˢ_k`` has covariance
 ``P(k|k) − Pˢ_k`` (the smoothed error is orthogonal to the difference), so
 each ratio ``(x̂_i(k|k) − x̂ˢ_i(k)) / √(P_ii(k|k) − Pˢ_ii(k))`` should be
-standard normal; |ratio| > 3 flags a component whose filter and smoother
+standard normal; ``|ratio| > 3`` flags a component whose filter and smoother
 disagree more than their covariances allow (:func:`filter_smoother_consistency`).
 
 **Not smoothed here.** The H∞ filters: their P (if any) is the Riccati bound
@@ -352,7 +352,7 @@ def filter_smoother_consistency(x_filt: ArrayLike, P_filt: ArrayLike, x_smooth: 
     x_filt, x_smooth : array_like, shape (..., n)
     P_filt, P_smooth : array_like, shape (..., n, n)
     threshold : float
-        The bound on |ratio| (3: a standard-normal ratio exceeds it with
+        The bound on ``|ratio|`` (3: a standard-normal ratio exceeds it with
         probability 0.27 %).
     floor : float
         A variance difference below ``floor · P_ii(k|k)`` (e.g. the last
@@ -361,7 +361,7 @@ def filter_smoother_consistency(x_filt: ArrayLike, P_filt: ArrayLike, x_smooth: 
     Returns
     -------
     dict
-        ``ratio`` (..., n); ``exceeds`` (..., n), |ratio| > threshold (False
+        ``ratio`` (..., n); ``exceeds`` (..., n), ``|ratio| > threshold`` (False
         where NaN); ``fraction_exceeding`` (n,), over every finite ratio.
     """
     xf, xs = np.asarray(x_filt, dtype=float), np.asarray(x_smooth, dtype=float)

@@ -44,7 +44,7 @@ __all__ = [
     "wrap_user_methods",
 ]
 
-#: Default tolerance of the first-call Jacobian check (relative to max(1, max |J_fd|)).
+#: Default tolerance of the first-call Jacobian check (relative to ``max(1, max |J_fd|)``).
 JACOBIAN_TOL = 1e-4
 
 
@@ -132,7 +132,7 @@ def _check_shape(model, fname, out, shapes, t):
 
 
 def call_model(model, fname, fun, x, rest=(), *, out_tail, t=None, allow_shared=False, state=None):
-    """``fun(x, *rest)`` checked as the module docstring says; returns the (runs, *out_tail) result.
+    """``fun(x, *rest)`` checked as the module docstring says; returns the ``(runs, *out_tail)`` result.
 
     Parameters
     ----------
