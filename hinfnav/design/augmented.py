@@ -125,13 +125,13 @@ def cell_alphas(system, points: int | None = None, n_random: int = 0, seed=0) ->
 def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alphas, log):
     """Minimize γ; when that does not certify, search γ upwards by doubling then bisect (internal)."""
     sol = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv)
-    seconds = sol["seconds"]
+    seconds, calls = sol["seconds"], sol["calls"]
     g_s = float(np.sqrt(sol["gamma2"])) if np.isfinite(sol["gamma2"]) and sol["gamma2"] > 0 else float("nan")
     cand = _certify(system, sol, nominal, part.T, cells, alphas) if "B_F" in sol else {"gamma": float("inf"), "ok": False}
     log.append(f"{slv} (augmented observer, {len(cells)} cells) minimize: status {sol['status']}, solver γ = "
                f"{g_s:.10g}, certified γ = {cand['gamma']:.10g}")
     if cand["ok"] and cand["gamma"] <= g_s * (1 + 2e-2):
-        return cand, g_s, seconds, sol["status"]
+        return cand, g_s, seconds, calls, sol["status"]
     # an interior point above the optimum certifies: double γ from the solver's level (or the sampled
     # norm of the barycentre's problem) until a strictly feasible point certifies, then bisect
     lo = g_s if np.isfinite(g_s) else 0.0
@@ -142,6 +142,7 @@ def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alpha
             break
         sol2 = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv, gamma2=g * g)
         seconds += sol2["seconds"]
+        calls += sol2["calls"]
         c2 = (_certify(system, sol2, nominal, part.T, cells, alphas) if "B_F" in sol2 and sol2["margin"] > 0
               else {"gamma": float("inf"), "ok": False})
         log.append(f"{slv} feasibility at γ = {g:.6g}: margin {sol2.get('margin', float('nan')):.3g}, "
@@ -151,7 +152,7 @@ def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alpha
             break
         lo, g = g, 2 * g
     if ok_hi is None:
-        return cand, g_s, seconds, sol["status"]
+        return cand, g_s, seconds, calls, sol["status"]
     hi = min(g, ok_hi["gamma"])
     for _ in range(5):
         if hi <= lo * 1.02:
@@ -159,6 +160,7 @@ def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alpha
         mid = 0.5 * (lo + hi)
         sol2 = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv, gamma2=mid * mid)
         seconds += sol2["seconds"]
+        calls += sol2["calls"]
         c2 = (_certify(system, sol2, nominal, part.T, cells, alphas) if "B_F" in sol2 and sol2["margin"] > 0
               else {"gamma": float("inf"), "ok": False})
         log.append(f"{slv} bisection at γ = {mid:.6g}: certified γ = {c2['gamma']:.10g}")
@@ -168,7 +170,7 @@ def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alpha
                 ok_hi = c2
         else:
             lo = mid
-    return ok_hi, g_s, seconds, sol["status"]
+    return ok_hi, g_s, seconds, calls, sol["status"]
 
 
 def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alphas=None,
@@ -185,7 +187,7 @@ def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alp
     dict
         ``ok`` and, when a filter certified, ``A_F, B_F, C_F, gamma, lmi_gamma,
         witness, norms, radii, solver``; always ``log``, ``statuses``,
-        ``seconds``, ``part`` (:class:`~hinfnav.analysis.marginal.ReadPart`),
+        ``seconds``, ``calls`` (solver invocations), ``part`` (:class:`~hinfnav.analysis.marginal.ReadPart`),
         ``alphas``.
 
     Raises
@@ -201,17 +203,18 @@ def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alp
     alphas = cell_alphas(system) if alphas is None else np.asarray(alphas)
     cells = cell_weights(system)
     verts = [[(lambda s: (s.A, s.B, s.C, s.D, s.L))(system.at(a)) for a in W] for W in cells]
-    log, statuses, seconds, best = [], [], 0.0, None
+    log, statuses, seconds, calls, best = [], [], 0.0, 0, None
     for slv in solvers:
-        cand, g_s, sec, status = _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alphas, log)
+        cand, g_s, sec, n, status = _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alphas, log)
         seconds += sec
+        calls += n
         statuses.append(f"{slv} {status}")
         if cand["ok"] and (best is None or cand["gamma"] < best["gamma"]):
             best = dict(cand, solver=slv, lmi_gamma=g_s if np.isfinite(g_s) else cand["gamma"])
         if best is not None and best["gamma"] <= best["lmi_gamma"] * (1 + 2e-2):
             break  # within 2 % of the solver's own optimum: the next solver would not do much better
-    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "part": part,
-           "alphas": alphas}
+    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "calls": calls,
+           "part": part, "alphas": alphas}
     if best is not None:
         out.update(best)
     return out

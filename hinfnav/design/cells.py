@@ -85,10 +85,11 @@ def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[
     cells = cell_weights(system)
     alphas = cell_alphas(system)
     verts = [[(lambda s: (s.A, s.B, s.C, s.D, s.L))(system.at(a)) for a in W] for W in cells]
-    log, statuses, seconds, best = [], [], 0.0, None
+    log, statuses, seconds, calls, best = [], [], 0.0, 0, None
     for slv in solvers:
         sol = solve_cells_general(verts, lyapunov, slv)
         seconds += sol["seconds"]
+        calls += sol["calls"]
         statuses.append(f"{slv} {sol['status']}")
         g_s = float(np.sqrt(sol["gamma2"])) if np.isfinite(sol["gamma2"]) and sol["gamma2"] > 0 else float("nan")
         cand = _certify(system, sol, cells, alphas)
@@ -98,6 +99,7 @@ def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[
             for step in (1e-3, 1e-2, 5e-2, 0.2, 1.0):
                 sol2 = solve_cells_general(verts, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2)
                 seconds += sol2["seconds"]
+                calls += sol2["calls"]
                 c2 = _certify(system, sol2, cells, alphas) if sol2.get("margin", -1) > 0 else {"gamma": float("inf"),
                                                                                              "ok": False}
                 log.append(f"{slv} feasibility at γ = {g_s * (1 + step):.10g}: certified γ = {c2['gamma']:.10g}")
@@ -107,7 +109,8 @@ def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[
         if cand["ok"] and (best is None or cand["gamma"] < best["gamma"]):
             best = dict(cand, solver=slv, lmi_gamma=g_s if np.isfinite(g_s) else cand["gamma"])
             break
-    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "alphas": alphas}
+    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "calls": calls,
+           "alphas": alphas}
     if best is not None:
         out.update(best)
     return out

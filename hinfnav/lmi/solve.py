@@ -251,21 +251,21 @@ def solve_once(cons: list, level: Any, solver: str, accuracy: float | None, t: A
     -------
     dict
         ``status`` (cvxpy's, or ``"solver error (...)"``), ``gamma2`` (the
-        solver's minimum, or ``gamma2``; NaN without a solution) and
-        ``seconds``.
+        solver's minimum, or ``gamma2``; NaN without a solution),
+        ``seconds`` and ``calls`` (solver invocations: 1).
     """
     if gamma2 is None:
         prob = cp.Problem(cp.Minimize(level), cons)
     else:
         prob = cp.Problem(cp.Maximize(t), list(cons) + [t <= 1e-3 * min(1.0, float(gamma2))])
-    status, seconds, _ = run_solver(prob, solver, accuracy, retry=False)
+    status, seconds, calls = run_solver(prob, solver, accuracy, retry=False)
     if status.startswith("solver error"):
         g2 = float("nan")
     elif gamma2 is None:
         g2 = float(level.value) if level.value is not None else float("nan")
     else:
         g2 = float(gamma2)
-    return {"status": status, "gamma2": g2, "seconds": seconds}
+    return {"status": status, "gamma2": g2, "seconds": seconds, "calls": calls}
 
 
 def solve_once_gamma(cons: list, g2: Any, solver: str, accuracy: float | None) -> dict[str, Any]:
