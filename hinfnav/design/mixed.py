@@ -66,7 +66,7 @@ from ..lmi.robust_h2 import robust_h2_bound
 from ..lmi.solve import INFEASIBLE, SolverOptions
 from ..systems.uncertain import UncertainSystem
 from .arguments import system_argument
-from .certify_loop import solve_and_certify
+from .certify_loop import Check, solve_and_certify
 from .result import DesignResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
@@ -225,16 +225,6 @@ def knee_index(gammas: ArrayLike, nus: ArrayLike) -> int:
     x = (g - g[0]) / (g[-1] - g[0])
     y = (v - v[-1]) / (v[0] - v[-1])
     return int(np.argmax(1.0 - x - y))
-
-
-@dataclass
-class _NuCheck:
-    """What the certify loop reads of a mixed certificate: the level it minimises is ν (internal)."""
-
-    ok: bool
-    gamma: float
-    reason: str
-    inner: Any
 
 
 @dataclass
@@ -410,7 +400,7 @@ class _Designer:
                        f"certified ν = {chk.nu:.10g}, γ = {chk.gamma:.10g}: {chk.reason}")
             if chk.reason.startswith("certified γ"):
                 exceeded.append(sol.solver)
-            return _NuCheck(chk.ok, chk.nu, chk.reason, chk)
+            return Check(chk.ok, chk.nu, chk.reason, chk)  # the level the loop compares is ν
 
         run = solve_and_certify([("at γ", variant(gamma_req))], list(opts.solvers),
                                 lambda v, sol: certify(v, sol, gamma_req), method="minimize", polish=opts.polish,
@@ -432,7 +422,7 @@ class _Designer:
             raise CertificationError(f"no solution of the mixed H2/H∞ LMIs at {what} passed certification: "
                                      + " | ".join(log))
         best = run.best()
-        return self._result(best.check.inner, best.sol, best.solver, gamma_req, run.seconds, tuple(log),
+        return self._result(best.check.data, best.sol, best.solver, gamma_req, run.seconds, tuple(log),
                             time.perf_counter() - t0, run.calls + self.certificate_calls)
 
     def _result(self, chk, sol, slv, gamma_req, seconds, log, total, calls):
@@ -494,6 +484,9 @@ def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float
     Returns
     -------
     DesignResult
+        With ``objective="mixed"``, the certified H2 bound ``h2_bound`` (and
+        ``h2_lmi``, ``h2_synthesis_bound``, ``h2_analysis_bound``,
+        ``h2_verified``, ``h2_sample_norms``) and the requested ``gamma_bound``.
 
     Raises
     ------

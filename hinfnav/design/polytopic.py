@@ -27,7 +27,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import control
@@ -47,7 +46,7 @@ from ..systems.uncertain import UncertainSystem
 from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
 from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
-from .certify_loop import solve_and_certify
+from .certify_loop import Check, solve_and_certify
 from .result import COVERS_NOMINAL, DesignResult
 
 __all__ = ["LYAPUNOV", "COVERS", "synthesize_polytopic", "certify_polytopic",
@@ -253,7 +252,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     def certify(_, sol):
         out = _rebuild_and_certify(system, sol.as_dict(), form, alphas, objective)
-        return _PolyCheck(out[-1], out[0], "certified" if out[-1] else "not certified", out)
+        return Check(out[-1], out[0], "certified" if out[-1] else "not certified", out)
 
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
@@ -333,14 +332,6 @@ def _cells_result(system, lyapunov, solvers, t0):
         witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
         total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
         objective="hinf")
-@dataclass
-class _PolyCheck:
-    """What the certify loop needs of a polytopic certificate (internal)."""
-
-    ok: bool
-    gamma: float
-    reason: str
-    data: tuple
 
 
 def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):

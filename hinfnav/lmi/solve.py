@@ -178,6 +178,14 @@ class Solution:
             return 0.0
         raise AttributeError(f"Solution has no value {name!r}")
 
+    @classmethod
+    def from_dict(cls, out: dict, solver: str) -> Solution:
+        """The solution of a problem built in a single shot: :func:`solve_once`'s dict plus the values read into it."""
+        head = ("status", "gamma2", "seconds", "calls", "margin")
+        values = {k: v for k, v in out.items() if k not in head}
+        return cls(out["status"], out["gamma2"], values, out.get("margin", float("nan")), out["seconds"], solver,
+                   out.get("calls", 1))
+
     def as_dict(self) -> dict:
         """``status``, ``gamma2``, ``seconds``, and when solved ``margin`` and the values (a flat dict)."""
         out = {"status": self.status, "gamma2": self.gamma2, "seconds": self.seconds}
