@@ -50,7 +50,8 @@ from ..core.linalg import discretize
 from ..core.validation import as_positive
 from ..systems.parametric import Coverage, polytope_coverage, polytope_from_parameters
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
-from .polytopic import DesignResult, synthesize_polytopic
+from .polytopic import synthesize_polytopic
+from .result import DesignResult
 
 __all__ = ["design_discrete_at_rate", "DiscreteAtRate", "zoh_plant"]
 

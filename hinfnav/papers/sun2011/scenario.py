@@ -264,6 +264,9 @@ class Scenario(BaseScenario):
         """
         if not isinstance(design, DesignResult):
             raise InputError(f"design must be a hinfnav DesignResult; got {type(design).__name__}")
+        if design.domain != "discrete":
+            raise InputError(f"design must be a discrete-time filter (this one is {design.domain} time): design it "
+                             "for the scenario's sampled model")
         dt = None if design.dt is True else design.dt
         return self.lti_filter(design.A_F, design.B_F, design.C_F, name=name, uses_input=not verbatim, design_dt=dt)
 
