@@ -137,11 +137,11 @@ def certify_front(front, system):
 
 def _recertified(system, res):
     """``res`` with γ the smaller of its own and the analysis certificate; its own kept in
-    ``variables["gamma_synthesis"]`` (the level its returned LMI variables certify)."""
+    ``witness["gamma_synthesis"]`` (the level its returned LMI variables certify)."""
     g = analysis_gamma(system, res)
     if not g < res.gamma:
         return res
-    return dataclasses.replace(res, gamma=g, variables=dict(res.variables or {}, gamma_synthesis=float(res.gamma)))
+    return dataclasses.replace(res, gamma=g, witness=dict(res.witness or {}, gamma_synthesis=float(res.gamma)))
 
 
 def certified_knee(front):
