@@ -278,7 +278,7 @@ def design_report_from(res):
         "form": res.form,
         "gamma": res.gamma,
         "lmi_gamma": res.lmi_gamma,
-        "lmi20_gamma": float(res.variables.get("lmi20_gamma", res.gamma)),
+        "lmi20_gamma": float(res.witness.get("lmi20_gamma", res.gamma)),
         "verified_norm": res.verified_norm,
         "worst_delta": res.worst_value,
         "spectral_radius": res.spectral_radius,
