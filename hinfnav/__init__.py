@@ -57,7 +57,7 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
         worst_case_norm,
     )
     from .design import (
-        MixedSynthesisResult, PolytopicResult, recertify, SampleSet, SolverOptions, SynthesisResult,
+        DesignResult, recertify, SampleSet, SolverOptions,
         synthesize, synthesize_mixed, synthesize_polytopic,
     )
     from .estimators import (
@@ -154,14 +154,12 @@ __all__ = [
     "read_campaign",
     "Campaign",
     "synthesize_mixed",
-    "MixedSynthesisResult",
     "HuberFilter",
     "RecursiveHInfinityFilter",
-    "SynthesisResult",
+    "DesignResult",
     "SolverOptions",
     "SampleSet",
     "synthesize_polytopic",
-    "PolytopicResult",
     "recertify",
     # estimators
     "Estimator",

@@ -111,7 +111,7 @@ def test_lmi20_holds_at_returned_unscaled_variables(paper_design, scenario):
     # coordinates, balanced H, E) is negative definite at the returned γ: a solver-free check
     res = paper_design
     s = scenario.design_model(0.05)
-    v = res.variables
+    v = res.witness
     M0 = lmi20_matrix(s.A, s.B, s.C, s.D, s.L, v["H"], v["E"], v["R"], v["S"], v["Abar_F"], v["Bbar_F"], v["Cbar_F"], v["lam"], 0.0)
     n, p, q = 6, 6, 3
     gamma, _ = schur_gamma(M0, np.arange(4 * n, 4 * n + p + q))
@@ -390,7 +390,7 @@ def test_observer_form_structure_holds_to_round_off(observer_design, scenario):
     assert obs["residual"] < 1e-9 * np.max(np.abs(s.A))
     np.testing.assert_allclose(obs["G"], -res.B_F, rtol=1e-12)
     # the LMI variables satisfy the constraints too: Ā_F = S A_F = S A + B̄_F C
-    v = res.variables
+    v = res.witness
     assert _rel(v["Abar_F"] - (v["S"] @ s.A + v["Bbar_F"] @ s.C), v["Abar_F"]) < 1e-9
     # certification is the general one: LMI (20) at the returned variables gives the returned γ, and every
     # sampled norm is below it. Tolerance 1e-5 (1e-6 for the general design): R − S has eigenvalues from 8e-5
@@ -398,12 +398,12 @@ def test_observer_form_structure_holds_to_round_off(observer_design, scenario):
     # unscaled coordinates moves the Schur-complement γ by ~1.5e-6 (measured)
     M0 = lmi20_matrix(s.A, s.B, s.C, s.D, s.L, v["H"], v["E"], v["R"], v["S"], v["Abar_F"], v["Bbar_F"], v["Cbar_F"], v["lam"], 0.0)
     gamma, _ = schur_gamma(M0, np.arange(24, 24 + 9))
-    assert gamma == pytest.approx(res.variables["lmi20_gamma"], rel=1e-5)
+    assert gamma == pytest.approx(res.witness["lmi20_gamma"], rel=1e-5)
     assert res.verified_norm <= res.gamma and res.spectral_radius < 1
     # measured value (this module, CVXOPT polish, November 2026): (20) with its restricted Lyapunov matrix certifies
     # 0.358738, 0.03 % above γ*; the reported γ is the filter's own, with a full Lyapunov matrix (robust bounded
     # real LMI, issue 8): 0.358644, within 3e-8 of γ* (test_design_corner_cases checks it independently)
-    assert res.variables["lmi20_gamma"] == pytest.approx(0.358738, rel=1e-4)
+    assert res.witness["lmi20_gamma"] == pytest.approx(0.358738, rel=1e-4)
     assert res.gamma == pytest.approx(0.358644, rel=1e-5)
 
 
@@ -447,7 +447,7 @@ def test_observer_gamma_is_at_least_general_and_passes_through_sweep(paper_desig
     assert observer_design.gamma >= paper_design.gamma * (1 - 1e-6)
     assert observer.gammas[0] == pytest.approx(general.gammas[0], rel=1e-5)
     assert observer.gammas[1] == pytest.approx(0.359644, rel=1e-5)
-    assert observer.results[1].variables["lmi20_gamma"] == pytest.approx(0.361529, rel=1e-4)
+    assert observer.results[1].witness["lmi20_gamma"] == pytest.approx(0.361529, rel=1e-4)
     for r in observer.results:
         assert r.verified_norm <= r.gamma and r.spectral_radius < 1
         s = sc.design_model(r.uncertainty_bound)

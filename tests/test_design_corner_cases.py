@@ -41,7 +41,7 @@ def test_noise_scaled_system_designs_and_certifies(random_uncertain):
     # the certificate is that of the ORIGINAL data: LMI (20) with B × 1000, D ÷ 1000 at the returned variables
     # (original units), tested here after our own power-of-two equilibration of rows and columns (exact), and
     # the smallest γ making it negative definite is the returned one (1e-6: Schur complement, two roundings)
-    v = res.variables
+    v = res.witness
     M0 = lmi20_matrix(A, Bs, C, Ds, L, v["H"], v["E"], v["R"], v["S"], v["Abar_F"], v["Bbar_F"], v["Cbar_F"], v["lam"], 0.0)
     n, p, q = 3, 2, 2
     k = 2.0 ** np.round(np.log2(np.sqrt(np.abs(np.diag(M0)) + 1e-300)))  # powers of two: exact congruence
@@ -134,7 +134,7 @@ def _robust_level(Ab, Bb, Cb, Hb, Eb):
 
 def test_observer_gamma_is_the_full_lyapunov_level(scenario):
     # issue 8 measured 0.358644 at δ̄ = 0.05 in independent code; LMI (20)'s restricted Lyapunov matrix gives
-    # 0.358738 (kept as variables["lmi20_gamma"]; lmi_gamma is the solver's). Here: the returned γ equals the level
+    # 0.358738 (kept as witness["lmi20_gamma"]; lmi_gamma is the solver's). Here: the returned γ equals the level
     # of the independent computation above to 1e-6 relative (measured agreement 2e-9)
     res = design_for_scenario(scenario, 0.05, form="observer")
     s = scenario.design_model(0.05)
@@ -143,8 +143,8 @@ def test_observer_gamma_is_the_full_lyapunov_level(scenario):
     level = _robust_level(Ab, Bb, Cb, np.vstack([H, 0 * H]), np.hstack([E, 0 * E]))
     assert res.gamma == pytest.approx(level, rel=1e-6)
     assert res.gamma == pytest.approx(0.358644, rel=1e-5)
-    assert res.variables["lmi20_gamma"] == pytest.approx(0.358738, rel=1e-5)
-    assert res.verified_norm <= res.gamma < res.variables["lmi20_gamma"]
+    assert res.witness["lmi20_gamma"] == pytest.approx(0.358738, rel=1e-5)
+    assert res.verified_norm <= res.gamma < res.witness["lmi20_gamma"]
 
 
 # ------------------------------------------------------------------ the printed factors: small gain

@@ -121,7 +121,7 @@ def test_certificates_hold_when_rechecked_independently(scenario, near_opt):
     # the extended H∞ LMI at the returned filter and the returned variables (original coordinates),
     # with γ 1e-6 above the level they certify, is negative definite (issue 22: ``gamma`` may be the smaller
     # robust-BRL certificate of the filter alone; the synthesis level is then kept as ``gamma_synthesis``)
-    v = res.variables
+    v = res.witness
     gamma_lmi = v.get("gamma_synthesis", res.gamma)
     assert res.gamma <= gamma_lmi
     Abar, Bbar, Cbar = error_system_matrices(s.A, s.B, s.C, s.D, s.L, res.A_F, res.B_F, res.C_F)

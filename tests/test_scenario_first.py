@@ -18,7 +18,7 @@ import pytest
 
 import hinfnav
 from hinfnav.campaign.registry import build_scenario, registered_scenarios
-from hinfnav.design.result import SynthesisResult
+from hinfnav.design.result import DesignResult
 from hinfnav.estimators.registry import build_estimator, fit_reason
 from hinfnav.papers import attitude2018, benchmark, shi2018, sun2011, yang2020
 from hinfnav.papers.attitude2018.chaser import run_passes
@@ -67,7 +67,7 @@ def test_engine_resolve_estimator_and_estimators():
     for given in (["ekf", "published"], {"a": "ekf", "b": ekf}):
         assert list(old_order(resolve_estimators, given, SUN)) == list(new_order(resolve_estimators, SUN, given))
     # a design as the earlier first argument is recognised (its module is loaded whenever a design exists)
-    design = SynthesisResult(A_F=np.eye(1), B_F=np.eye(1), C_F=np.eye(1), gamma=1.0, lmi_gamma=1.0, verified_norm=1.0,
+    design = DesignResult(A_F=np.eye(1), B_F=np.eye(1), C_F=np.eye(1), gamma=1.0, lmi_gamma=1.0, verified_norm=1.0,
                              sample_norms=np.array([1.0]), worst_sample=0, spectral_radius=0.5, solver="x",
                              solve_time_s=0.0, total_time_s=0.0, method="minimize", uncertainty_bound=0.0,
                              sample_values=np.array([0.0]))

@@ -63,9 +63,9 @@ def test_synthesis_result_old_attribute_names_warn_and_agree():
     """``delta_bar``/``deltas``/``worst_delta`` (before issue 23) map to the generic names, with a warning."""
     import warnings
 
-    from hinfnav.design.result import _RENAMED, SynthesisResult
+    from hinfnav.design.result import _RENAMED, DesignResult
 
-    res = SynthesisResult(A_F=np.eye(1), B_F=np.eye(1), C_F=np.eye(1), gamma=1.0, lmi_gamma=1.0, verified_norm=1.0,
+    res = DesignResult(A_F=np.eye(1), B_F=np.eye(1), C_F=np.eye(1), gamma=1.0, lmi_gamma=1.0, verified_norm=1.0,
                           sample_norms=np.array([0.5, 1.0]), worst_sample=1, spectral_radius=0.5, solver="x",
                           solve_time_s=0.0, total_time_s=0.0, method="minimize", uncertainty_bound=0.3,
                           sample_values=np.array([-0.3, 0.3]))

@@ -17,7 +17,7 @@ checks shapes and raises :class:`~hinfnav.core.exceptions.InputError`).
   (``LinearSystem``, ``DynamicsModel``; ``MeasurementModel``);
 * :class:`EstimatorHooks`: the hooks behind :class:`hinfnav.estimators.Estimator`'s checked
   ``start``/``update``/``predict`` and ``estimate``;
-* :class:`DesignResultProtocol`: a certified filter design (``SynthesisResult``, ``PolytopicResult``).
+* :class:`DesignResultProtocol`: a certified filter design (``hinfnav.design.DesignResult``).
 
 A scenario of your own needs only the two members of :class:`ScenarioProtocol`
 (``truth_model(**conditions)`` returning a :class:`hinfnav.sim.TruthModel`,

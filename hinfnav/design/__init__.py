@@ -12,14 +12,14 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     from ..lmi.solve import SOLVERS, SolverOptions
     from .from_file import design_from_system_file, design_summary
     from .io import check_design_system, load_design, save_design, system_fingerprint
-    from .mixed import MixedFront, MixedSynthesisResult, front_gammas, knee_index, mixed_front, synthesize_mixed
+    from .mixed import MixedFront, front_gammas, mixed_row, knee_index, mixed_front, synthesize_mixed
     from .compare import compare_uncertainty_models
-    from .continuous import ContinuousResult, design_continuous_system, synthesize_continuous_observer
+    from .continuous import design_continuous_system, synthesize_continuous_observer
     from .discretised import DiscreteAtRate, design_discrete_at_rate
     from .explain import small_gain_number
-    from .polytopic import PolytopicResult, certify_polytopic, synthesize_polytopic
+    from .polytopic import certify_polytopic, synthesize_polytopic
     from .recertify import recertify
-    from .result import SynthesisResult
+    from .result import DesignResult
     from .robust_hinf import FORMS, synthesize
     from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
@@ -27,11 +27,11 @@ __all__ = [
     "synthesize",
     "synthesize_mixed",
     "mixed_front",
-    "MixedSynthesisResult",
+    "mixed_row",
     "MixedFront",
     "front_gammas",
     "knee_index",
-    "SynthesisResult",
+    "DesignResult",
     "SolverOptions",
     "SOLVERS",
     "FORMS",
@@ -45,13 +45,11 @@ __all__ = [
     "system_fingerprint",
     "synthesize_polytopic",
     "certify_polytopic",
-    "PolytopicResult",
     "small_gain_number",
     "recertify",
     "design_from_system_file",
     "design_summary",
     "compare_uncertainty_models",
-    "ContinuousResult",
     "design_continuous_system",
     "synthesize_continuous_observer",
     "DiscreteAtRate",

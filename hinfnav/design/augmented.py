@@ -39,10 +39,18 @@ from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..lmi.augmented_observer import solve_augmented_observer
 from ..lmi.polytopic import extended_hinf_positive, hinf_gamma_index
+from ..lmi.solve import Solution
 from ..systems.polytopic import simplex_grid
+from .certify_loop import Check, Loop, loop_outcome, solve_and_certify
 
 __all__ = ["needs_augmented", "certify_augmented", "augmented_norms", "design_augmented_observer", "cell_weights",
            "cell_alphas"]
+
+
+#: Accept a certified minimisation within 2 % of the solver's level; bisect to 2 %.
+TIGHT = 2e-2
+#: Levels tried above the solver's γ when its point does not certify: ×1.01, then doubling (12 levels).
+DOUBLING = tuple(1.01 * 2.0**k - 1.0 for k in range(12))
 
 
 def _tuples(system):
@@ -122,55 +130,6 @@ def cell_alphas(system, points: int | None = None, n_random: int = 0, seed=0) ->
     return np.unique(np.round(np.vstack(out), 15), axis=0)
 
 
-def _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alphas, log):
-    """Minimize γ; when that does not certify, search γ upwards by doubling then bisect (internal)."""
-    sol = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv)
-    seconds = sol["seconds"]
-    g_s = float(np.sqrt(sol["gamma2"])) if np.isfinite(sol["gamma2"]) and sol["gamma2"] > 0 else float("nan")
-    cand = _certify(system, sol, nominal, part.T, cells, alphas) if "B_F" in sol else {"gamma": float("inf"), "ok": False}
-    log.append(f"{slv} (augmented observer, {len(cells)} cells) minimize: status {sol['status']}, solver γ = "
-               f"{g_s:.10g}, certified γ = {cand['gamma']:.10g}")
-    if cand["ok"] and cand["gamma"] <= g_s * (1 + 2e-2):
-        return cand, g_s, seconds, sol["status"]
-    # an interior point above the optimum certifies: double γ from the solver's level (or the sampled
-    # norm of the barycentre's problem) until a strictly feasible point certifies, then bisect
-    lo = g_s if np.isfinite(g_s) else 0.0
-    g = max(lo * 1.01, 1e-3)
-    ok_hi = cand if cand["ok"] else None
-    for _ in range(12):
-        if ok_hi is not None and g >= ok_hi["gamma"]:
-            break
-        sol2 = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv, gamma2=g * g)
-        seconds += sol2["seconds"]
-        c2 = (_certify(system, sol2, nominal, part.T, cells, alphas) if "B_F" in sol2 and sol2["margin"] > 0
-              else {"gamma": float("inf"), "ok": False})
-        log.append(f"{slv} feasibility at γ = {g:.6g}: margin {sol2.get('margin', float('nan')):.3g}, "
-                   f"certified γ = {c2['gamma']:.10g}")
-        if c2["ok"]:
-            ok_hi = c2 if ok_hi is None or c2["gamma"] < ok_hi["gamma"] else ok_hi
-            break
-        lo, g = g, 2 * g
-    if ok_hi is None:
-        return cand, g_s, seconds, sol["status"]
-    hi = min(g, ok_hi["gamma"])
-    for _ in range(5):
-        if hi <= lo * 1.02:
-            break
-        mid = 0.5 * (lo + hi)
-        sol2 = solve_augmented_observer(verts, part.T, nominal, lyapunov, slv, gamma2=mid * mid)
-        seconds += sol2["seconds"]
-        c2 = (_certify(system, sol2, nominal, part.T, cells, alphas) if "B_F" in sol2 and sol2["margin"] > 0
-              else {"gamma": float("inf"), "ok": False})
-        log.append(f"{slv} bisection at γ = {mid:.6g}: certified γ = {c2['gamma']:.10g}")
-        if c2["ok"]:
-            hi = mid
-            if c2["gamma"] < ok_hi["gamma"]:
-                ok_hi = c2
-        else:
-            lo = mid
-    return ok_hi, g_s, seconds, sol["status"]
-
-
 def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alphas=None,
                               names: Sequence[str] | None = None) -> dict[str, Any]:
     """Design and certify an observer-form filter on ζ (internal; wrapped by ``synthesize_polytopic``).
@@ -185,7 +144,7 @@ def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alp
     dict
         ``ok`` and, when a filter certified, ``A_F, B_F, C_F, gamma, lmi_gamma,
         witness, norms, radii, solver``; always ``log``, ``statuses``,
-        ``seconds``, ``part`` (:class:`~hinfnav.analysis.marginal.ReadPart`),
+        ``seconds``, ``calls`` (solver invocations), ``part`` (:class:`~hinfnav.analysis.marginal.ReadPart`),
         ``alphas``.
 
     Raises
@@ -201,20 +160,23 @@ def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alp
     alphas = cell_alphas(system) if alphas is None else np.asarray(alphas)
     cells = cell_weights(system)
     verts = [[(lambda s: (s.A, s.B, s.C, s.D, s.L))(system.at(a)) for a in W] for W in cells]
-    log, statuses, seconds, best = [], [], 0.0, None
+
+    def solve(slv, gamma2=None):
+        return Solution.from_dict(solve_augmented_observer(verts, part.T, nominal, lyapunov, slv, gamma2=gamma2), slv)
+
+    def certify(_, sol):
+        c = (_certify(system, sol.as_dict(), nominal, part.T, cells, alphas) if "B_F" in sol.values
+             else {"gamma": float("inf"), "ok": False})
+        return Check(c["ok"], c["gamma"], "certified" if c["ok"] else "not certified", c)
+
+    run = Loop()
     for slv in solvers:
-        cand, g_s, sec, status = _solve_and_certify(system, cells, verts, part, nominal, lyapunov, slv, alphas, log)
-        seconds += sec
-        statuses.append(f"{slv} {status}")
-        if cand["ok"] and (best is None or cand["gamma"] < best["gamma"]):
-            best = dict(cand, solver=slv, lmi_gamma=g_s if np.isfinite(g_s) else cand["gamma"])
-        if best is not None and best["gamma"] <= best["lmi_gamma"] * (1 + 2e-2):
+        solve_and_certify([(f"augmented observer, {len(cells)} cells", solve)], [slv], certify, rtol=TIGHT,
+                          max_bisection=5, steps=DOUBLING, loop=run)
+        best = run.best()
+        if best is not None and best.check.gamma <= best.level * (1 + TIGHT):
             break  # within 2 % of the solver's own optimum: the next solver would not do much better
-    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "part": part,
-           "alphas": alphas}
-    if best is not None:
-        out.update(best)
-    return out
+    return loop_outcome(run, part=part, alphas=alphas)
 
 
 def _certify(system, sol, nominal, T, cells, alphas):

@@ -15,6 +15,7 @@ Lyapunov matrices) or every time-varying α(k) in the union (common).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -25,7 +26,9 @@ from ..analysis.error_system import worst_case_norm
 from ..core.exceptions import InputError
 from ..lmi.cells_general import solve_cells_general
 from ..lmi.polytopic import extended_hinf_positive, hinf_gamma_index
+from ..lmi.solve import Solution
 from .augmented import cell_alphas, cell_weights
+from .certify_loop import Check, Loop, loop_outcome, solve_and_certify
 
 __all__ = ["certify_cells_general", "design_cells_general"]
 
@@ -79,35 +82,25 @@ def _certify(system, sol, cells, alphas):
 def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[str, Any]:
     """Design and certify a general-form filter on the cells (internal; wrapped by ``synthesize_polytopic``).
 
-    Minimize γ; when the solver's point does not certify, maximize the margin at levels above the solver's γ
-    (×1.001 … ×2) and keep the first that certifies.
+    Through the one certify loop (:func:`~hinfnav.design.certify_loop.solve_and_certify`), one solver at a time
+    until one certifies: minimise γ; when the solver's point does not certify, maximise the margin at levels above
+    the solver's γ (×1.001 … ×2) and keep the first that certifies.
     """
     cells = cell_weights(system)
     alphas = cell_alphas(system)
     verts = [[(lambda s: (s.A, s.B, s.C, s.D, s.L))(system.at(a)) for a in W] for W in cells]
-    log, statuses, seconds, best = [], [], 0.0, None
-    for slv in solvers:
-        sol = solve_cells_general(verts, lyapunov, slv)
-        seconds += sol["seconds"]
-        statuses.append(f"{slv} {sol['status']}")
-        g_s = float(np.sqrt(sol["gamma2"])) if np.isfinite(sol["gamma2"]) and sol["gamma2"] > 0 else float("nan")
-        cand = _certify(system, sol, cells, alphas)
-        log.append(f"{slv} (general, {len(cells)} cells) minimize: status {sol['status']}, solver γ = {g_s:.10g}, "
-                   f"certified γ = {cand['gamma']:.10g}")
-        if not cand["ok"] and np.isfinite(g_s):
-            for step in (1e-3, 1e-2, 5e-2, 0.2, 1.0):
-                sol2 = solve_cells_general(verts, lyapunov, slv, gamma2=(g_s * (1 + step)) ** 2)
-                seconds += sol2["seconds"]
-                c2 = _certify(system, sol2, cells, alphas) if sol2.get("margin", -1) > 0 else {"gamma": float("inf"),
-                                                                                             "ok": False}
-                log.append(f"{slv} feasibility at γ = {g_s * (1 + step):.10g}: certified γ = {c2['gamma']:.10g}")
-                if c2["ok"]:
-                    cand = c2
-                    break
-        if cand["ok"] and (best is None or cand["gamma"] < best["gamma"]):
-            best = dict(cand, solver=slv, lmi_gamma=g_s if np.isfinite(g_s) else cand["gamma"])
+
+    def solve(slv, gamma2=None):
+        return Solution.from_dict(solve_cells_general(verts, lyapunov, slv, gamma2=gamma2), slv)
+
+    def certify(_, sol):
+        c = _certify(system, sol.as_dict(), cells, alphas)
+        return Check(c["ok"], c["gamma"], "certified" if c["ok"] else "not certified", c)
+
+    run = Loop()
+    for slv in solvers:  # any certified point is accepted (rtol = inf): no bisection
+        solve_and_certify([(f"general, {len(cells)} cells", solve)], [slv], certify, rtol=math.inf,
+                          max_bisection=0, steps=(1e-3, 1e-2, 5e-2, 0.2, 1.0), loop=run)
+        if run.candidates:
             break
-    out = {"ok": best is not None, "log": log, "statuses": statuses, "seconds": seconds, "alphas": alphas}
-    if best is not None:
-        out.update(best)
-    return out
+    return loop_outcome(run, alphas=alphas)

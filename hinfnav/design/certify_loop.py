@@ -28,7 +28,18 @@ from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable
 
-__all__ = ["Candidate", "Loop", "solve_and_certify"]
+__all__ = ["Candidate", "Check", "Loop", "solve_and_certify", "loop_outcome"]
+
+
+@dataclass
+class Check:
+    """A certificate as the loop reads it: ``ok``, the certified ``gamma`` (the level the design minimises: γ, or
+    ν for the mixed design) and a ``reason``; ``data`` is the design's own (filter, witness, norms ...)."""
+
+    ok: bool
+    gamma: float
+    reason: str
+    data: Any = None
 
 
 @dataclass
@@ -40,7 +51,7 @@ class Candidate:
     solver: str
     how: str
     variant: int = 0
-    level: float = float("nan")  # the solver's minimum the candidate descends from (NaN: bisection)
+    level: float = float("nan")  # the solver's minimum the candidate descends from (NaN: none solved)
 
 
 @dataclass
@@ -156,6 +167,7 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
     # 4. bisection on the level
     for slv in solvers:
         lo_hint = min((m[2] for m in mins if m[1] == slv and m[3] == "optimal"), default=None)
+        own = min((m[2] for m in mins if m[1] == slv), default=float("nan"))  # the solver's level (Candidate.level)
         lo = 0.0 if lo_hint is None else lo_hint * (1.0 - 10.0 * rtol)
         best = loop.best()
         hi = None if best is None else best.check.gamma
@@ -199,10 +211,23 @@ def solve_and_certify(variants: list, solvers: list, certify: Callable, *, rtol:
             failures = 0
             log.append(f"{slv} feasibility at γ = {mid:.10g}: margin {sol.margin:.3g}, certified γ = {chk.gamma:.10g}: {chk.reason}")
             if chk.ok and chk.gamma < hi:
-                accept(chk, sol, slv, "bisection", v)
+                accept(chk, sol, slv, "bisection", v, own)
                 hi = chk.gamma
             if not chk.ok or chk.gamma > mid:
                 lo = mid
         if loop.candidates and not polish:
             break
     return loop
+
+
+def loop_outcome(loop: Loop, **extra: Any) -> dict:
+    """The loop as a dict (``ok``, ``log``, ``statuses``, ``seconds``, ``calls``, ``extra``) and, when a candidate
+    certified, its :class:`Check` ``data`` with ``solver`` and ``lmi_gamma`` (the solver's level it descends from,
+    or its certified level after a bisection)."""
+    best = loop.best()
+    out = {"ok": best is not None, "log": loop.log, "statuses": [f"{slv} {st}" for slv, st in loop.statuses],
+           "seconds": loop.seconds, "calls": loop.calls, **extra}
+    if best is not None:
+        out.update(best.check.data, solver=best.solver,
+                   lmi_gamma=best.level if math.isfinite(best.level) else best.check.gamma)
+    return out

@@ -21,14 +21,14 @@ measure its coverage instead; :func:`hinfnav.design.discretised.design_discrete_
 
 From a TOML file with ``dt = 0``: :func:`design_continuous_system` (what
 ``design --system FILE --form observer`` calls) returns a
-:class:`ContinuousResult`. Saving it (``--save``) is refused: the design-file
+:class:`~hinfnav.design.DesignResult` with ``domain="continuous"``. Saving it (``--save``) is refused: the design-file
 format and ``--recertify`` carry discrete-time certificates only.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -40,8 +40,9 @@ from ..core.exceptions import CertificationError, UnstablePlantError
 from ..lmi.continuous import certify_continuous, solve_continuous_observer
 from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import simplex_grid
+from .result import DesignResult
 
-__all__ = ["synthesize_continuous_observer", "continuous_augmented", "ContinuousResult", "design_continuous_system"]
+__all__ = ["synthesize_continuous_observer", "continuous_augmented", "design_continuous_system", "COVERS_CONTINUOUS"]
 
 COVERS_CONTINUOUS = ("every α constant in time in the simplex (parameter-dependent Lyapunov function), "
                      "continuous time")
@@ -67,7 +68,8 @@ def synthesize_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], *, e
     -------
     dict
         ``A_F, B_F, C_F, gamma`` (certified), ``lmi_gamma``, ``verified_norm`` (largest sampled norm),
-        ``eps``, ``witness``, ``states`` (read by the uncertainty).
+        ``eps``, ``witness``, ``states`` (read by the uncertainty), ``sample_norms`` at ``alphas``,
+        ``attempts``, ``calls`` (solver invocations, one per ε), ``seconds`` (in the solver).
     """
     verts = [tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in v) for v in vertices]
     N = len(verts)
@@ -79,9 +81,11 @@ def synthesize_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], *, e
             raise UnstablePlantError(f"the part of the state the uncertainty reads (states {part.states}) is not "
                                      f"Hurwitz at vertex {i}: no filter has a bounded error")
     alphas = simplex_grid(N, points=points)
-    best, log = None, []
+    best, log, calls, seconds = None, [], 0, 0.0
     for e in eps:
         sol = solve_continuous_observer(verts, T, (A0, C0, L0), e, solver)
+        calls += sol.get("calls", 1)
+        seconds += sol.get("seconds", 0.0)
         if "B_F" not in sol:
             log.append(f"ε = {e:g}: {sol['status']}")
             continue
@@ -101,39 +105,27 @@ def synthesize_continuous_observer(vertices: Sequence[Sequence[ArrayLike]], *, e
     if not max(norms) <= best["gamma"] * (1 + 1e-9):
         raise CertificationError(f"a sampled norm {max(norms):.8g} exceeds the certified γ {best['gamma']:.8g}")
     return dict(best, A_F=A0 + B_F @ C0, C_F=-L0, verified_norm=float(max(norms)), states=part.states,
-                attempts=tuple(log), sample_norms=np.array(norms))
-
-
-@dataclass(frozen=True)
-class ContinuousResult:
-    """A certified continuous-time observer-form filter ``ẋ_f = A_F x_f + B_F y``, ``ẑ = C_F x_f``."""
-
-    A_F: np.ndarray
-    B_F: np.ndarray
-    C_F: np.ndarray
-    gamma: float
-    lmi_gamma: float
-    verified_norm: float
-    sample_norms: np.ndarray
-    system: ContinuousPolytope
-    solver: str
-    eps: float
-    witness: dict = field(repr=False)
-    form: str = "observer"
-    lyapunov: str = "parameter-dependent"
-    covers: str = COVERS_CONTINUOUS
-    objective: str = "hinf"
+                attempts=tuple(log), sample_norms=np.array(norms), alphas=alphas, calls=calls, seconds=seconds)
 
 
 def design_continuous_system(system: ContinuousPolytope, *, solver: str | None = None,
-                             eps: Sequence[float] = (0.01, 0.1, 1.0), points: int = 41) -> ContinuousResult:
+                             eps: Sequence[float] = (0.01, 0.1, 1.0), points: int = 41) -> DesignResult:
     """Observer-form design for a :class:`~hinfnav.systems.continuous.ContinuousPolytope` (see the module docstring).
 
     ``sample_norms`` are the continuous-time norms of the error system at a
-    simplex grid of ``points`` per edge (one sample for a nominal plant).
+    simplex grid of ``points`` per edge (one sample for a nominal plant). The
+    result has ``domain="continuous"``, ``dt=0``, ``uncertainty="polytope"``,
+    ``lyapunov="parameter-dependent"``; its ``witness`` holds ``P``, ``F``,
+    ``G`` and the line-search value ``eps``.
     """
+    t0 = time.perf_counter()
     solver = solver or "CLARABEL"
     out = synthesize_continuous_observer(system.vertices, eps=eps, solver=solver, points=points)
-    return ContinuousResult(out["A_F"], out["B_F"], out["C_F"], float(out["gamma"]), float(out["lmi_gamma"]),
-                            float(out["verified_norm"]), np.asarray(out["sample_norms"]), system, solver,
-                            float(out["eps"]), out["witness"])
+    norms = np.asarray(out["sample_norms"])
+    return DesignResult(
+        A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=float(out["lmi_gamma"]),
+        verified_norm=float(out["verified_norm"]), sample_norms=norms, worst_sample=int(np.argmax(norms)),
+        solver=solver, solve_time_s=float(out["seconds"]), total_time_s=time.perf_counter() - t0, dt=0,
+        witness=dict(out["witness"], eps=float(out["eps"])), attempts=out["attempts"], form="observer", system=system,
+        solver_calls=int(out["calls"]), uncertainty="polytope", domain="continuous", lyapunov="parameter-dependent",
+        covers=COVERS_CONTINUOUS, alphas=np.asarray(out["alphas"]), objective="hinf")

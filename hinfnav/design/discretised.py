@@ -50,7 +50,8 @@ from ..core.linalg import discretize
 from ..core.validation import as_positive
 from ..systems.parametric import Coverage, polytope_coverage, polytope_from_parameters
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
-from .polytopic import PolytopicResult, synthesize_polytopic
+from .polytopic import synthesize_polytopic
+from .result import DesignResult
 
 __all__ = ["design_discrete_at_rate", "DiscreteAtRate", "zoh_plant"]
 
@@ -84,7 +85,7 @@ class DiscreteAtRate:
 
     Attributes
     ----------
-    result : PolytopicResult
+    result : DesignResult
         The certified discrete filter (``result.covers`` says which α).
     polytope : PolytopicSystem
         The discrete plants at the box corners (grid points with ``splits``).
@@ -95,7 +96,7 @@ class DiscreteAtRate:
         What the certificate covers, and the coverage caveat, in words.
     """
 
-    result: PolytopicResult
+    result: DesignResult
     polytope: PolytopicSystem
     coverage: Coverage
     dt: float

@@ -24,36 +24,28 @@ from ..systems.files import read_system_file
 from ..core.exceptions import InputError
 from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import PolytopicSystem
-from .continuous import ContinuousResult, design_continuous_system
-from .polytopic import COVERS, LYAPUNOV, PolytopicResult, synthesize_polytopic
+from .continuous import design_continuous_system
+from .polytopic import LYAPUNOV, synthesize_polytopic
 from ..lmi.solve import SolverOptions
 from .robust_hinf import synthesize
 
 if TYPE_CHECKING:
-    from .result import SynthesisResult
+    from .result import DesignResult
 
 __all__ = ["design_from_system_file", "design_summary"]
 
 
-def design_summary(result: SynthesisResult | PolytopicResult | ContinuousResult) -> dict[str, Any]:
-    """JSON-ready summary of a certified design (any result type)."""
-    poly = isinstance(result, (PolytopicResult, ContinuousResult))
-    system = result.system
-    if poly:
-        lyapunov, covers = result.lyapunov, result.covers
-    else:
-        lyapunov = "common"
-        covers = (COVERS["common"].replace("α(k) in the simplex", "F(k) with FᵀF ≤ I")
-                  if system is not None and system.H is not None else "the nominal system")
+def design_summary(result: DesignResult) -> dict[str, Any]:
+    """JSON-ready summary of a certified design (any design: its fields say what it certifies)."""
     return {
         "gamma": float(result.gamma),
         "lmi_gamma": float(result.lmi_gamma),
         "verified_worst_norm": float(result.verified_norm),
         "n_samples": int(np.size(result.sample_norms)),
-        "objective": getattr(result, "objective", "hinf"),
-        "lyapunov": lyapunov,
+        "objective": result.objective,
+        "lyapunov": result.lyapunov,
         "form": result.form,
-        "covers": covers,
+        "covers": result.covers,
         "solver": result.solver,
         "A_F": result.A_F.tolist(),
         "B_F": result.B_F.tolist(),
@@ -64,7 +56,7 @@ def design_summary(result: SynthesisResult | PolytopicResult | ContinuousResult)
 
 def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | None = None, form: str = "general",
                             objective: str = "hinf", solver: str | None = None
-                            ) -> tuple[SynthesisResult | PolytopicResult | ContinuousResult, dict[str, Any]]:
+                            ) -> tuple[DesignResult, dict[str, Any]]:
     """Read ``path`` (:func:`~hinfnav.systems.read_system_file`) and design a certified H∞ filter.
 
     Parameters
@@ -80,7 +72,7 @@ def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | Non
 
     Returns
     -------
-    (SynthesisResult or PolytopicResult, dict)
+    (DesignResult, dict)
         The result (with its ``system``) and :func:`design_summary`.
     """
     objective = as_choice("objective", objective, ("hinf", "h2"))

@@ -35,8 +35,7 @@ from ..io.provenance import provenance
 from ..core.validation import as_path, check_new_file
 from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
 from ..systems.uncertain import UncertainSystem
-from .polytopic import PolytopicResult
-from .result import SynthesisResult
+from .result import COVERS_NOMINAL, COVERS_NORM_BOUNDED, DesignResult
 
 __all__ = ["FORMAT", "system_fingerprint", "content_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
            "check_design_system", "check_design_path"]
@@ -97,10 +96,13 @@ def _same_system(a, b):
 
 
 def design_to_dict(result, system, *, options=None, extra=None):
-    """JSON-ready dict of a certified design (:class:`SynthesisResult` or :class:`PolytopicResult`) and its system."""
-    polytopic = isinstance(result, PolytopicResult)
-    if not (polytopic or isinstance(result, SynthesisResult)):
-        raise InputError(f"result must be a hinfnav SynthesisResult or PolytopicResult; got {type(result).__name__}")
+    """JSON-ready dict of a certified discrete-time design (a :class:`DesignResult`) and its system."""
+    if not isinstance(result, DesignResult):
+        raise InputError(f"result must be a hinfnav DesignResult; got {type(result).__name__}")
+    if result.domain != "discrete":
+        raise InputError(f"a design file carries discrete-time certificates only; this design is {result.domain} "
+                         "time: it cannot be saved")
+    polytopic = result.uncertainty == "polytope"
     want = PolytopicSystem if polytopic else UncertainSystem
     if not isinstance(system, want):
         raise InputError(f"system must be the {want.__name__} the filter was designed for; got {type(system).__name__}")
@@ -134,11 +136,10 @@ def design_to_dict(result, system, *, options=None, extra=None):
             method=result.method, structure=result.structure,
             uncertainty_bound=None if result.uncertainty_bound is None else float(result.uncertainty_bound),
             sample_values=None if result.sample_values is None else np.asarray(result.sample_values).tolist(),
-            covers="every time-varying F(k) with FᵀF ≤ I (one quadratic Lyapunov function)"
-            if system.H is not None else "the nominal system",
+            covers=result.covers if system.H is not None else COVERS_NOMINAL,
         )
         sysd = dict(_system_dict(system, dt), kind="norm-bounded")
-        witness = {k: _plain(v) for k, v in result.variables.items()}
+        witness = {k: _plain(v) for k, v in result.witness.items()}
     out = {
         "format": FORMAT,
         "filter": {"A_F": result.A_F.tolist(), "B_F": result.B_F.tolist(), "C_F": result.C_F.tolist(), "dt": dt},
@@ -194,8 +195,8 @@ def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
     system = PolytopicSystem(tuple(verts), float(s["dt"]), tuple(s.get("labels", ())),
                              tuple(tuple(c) for c in s.get("cells", ())))
     w = d.get("witness") or {}
-    result = PolytopicResult(
-        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),
+    result = DesignResult(
+        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]), uncertainty="polytope",
         verified_norm=float(c["verified_norm"]), sample_norms=np.asarray(c.get("sample_norms", []), dtype=float),
         alphas=np.asarray(c.get("alphas", []), dtype=float), worst_sample=int(c.get("worst_sample", 0)),
         spectral_radius=float(c["spectral_radius"]), lyapunov=str(c["lyapunov"]), form=str(c["form"]),
@@ -203,7 +204,7 @@ def _rebuild_polytopic(d, f, c, s, A_F, B_F, C_F, path):
         witness=dict({k: np.asarray(v, dtype=float) for k, v in w.items() if k != "P"},
                      P=[np.asarray(P, dtype=float) for P in w.get("P", [])]),
         solver=str(c.get("solver")), solve_time_s=float(c.get("solve_time_s", 0.0)),
-        total_time_s=float(c.get("total_time_s", 0.0)), dt=float(f["dt"]),
+        total_time_s=float(c.get("total_time_s", 0.0)), dt=float(f["dt"]), system=system,
     )
     return result, system, d
 
@@ -216,7 +217,7 @@ def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
     values = c.get("sample_values", c.get("deltas"))
     variables = {k: (np.asarray(v, dtype=float) if isinstance(v, list) and k != "P" else
                      [np.asarray(P, dtype=float) for P in v] if k == "P" else v) for k, v in w.items()}
-    result = SynthesisResult(
+    result = DesignResult(
         A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(c["gamma"]), lmi_gamma=float(c["lmi_gamma"]),
         verified_norm=float(c["verified_norm"]), sample_norms=np.asarray(c.get("sample_norms", []), dtype=float),
         worst_sample=int(c.get("worst_sample", 0)), spectral_radius=float(c["spectral_radius"]),
@@ -224,7 +225,8 @@ def _rebuild(d, f, c, s, mats, A_F, B_F, C_F, path):
         total_time_s=float(c.get("total_time_s", 0.0)), method=str(c.get("method")), dt=float(f["dt"]),
         structure=str(c.get("structure")), uncertainty_bound=bound, form=str(c.get("form")),
         sample_values=None if values is None else np.asarray(values, dtype=float),
-        variables=variables, system=system,
+        witness=variables, system=system,
+        covers=str(c.get("covers", COVERS_NOMINAL if system.H is None else COVERS_NORM_BOUNDED)),
     )
     return result, system, d
 
@@ -234,7 +236,7 @@ def check_design_path(path):
     return check_new_file("path", path, example="design.json")
 
 
-def save_design(result: SynthesisResult | PolytopicResult, system: UncertainSystem | PolytopicSystem,
+def save_design(result: DesignResult, system: UncertainSystem | PolytopicSystem,
                 path: str | os.PathLike[str], *, options: Mapping[str, Any] | None = None,
                 extra: Mapping[str, Any] | None = None) -> Path:
     """Write a design file (JSON); returns the path. The file is written whole or not at all."""
@@ -243,9 +245,8 @@ def save_design(result: SynthesisResult | PolytopicResult, system: UncertainSyst
     return atomic_write_text(path, text)  # whole or nothing; no temporary file left on a failure
 
 
-def load_design(path: str | os.PathLike[str]) -> tuple[SynthesisResult | PolytopicResult, UncertainSystem | PolytopicSystem,
-                                                     dict[str, Any]]:
-    """Read a design file; returns ``(SynthesisResult, UncertainSystem, dict)``."""
+def load_design(path: str | os.PathLike[str]) -> tuple[DesignResult, UncertainSystem | PolytopicSystem, dict[str, Any]]:
+    """Read a design file; returns ``(DesignResult, UncertainSystem or PolytopicSystem, dict)``."""
     path = as_path("path", path)
     if not path.is_file():
         raise InputError(f"design file {path} does not exist (or is not a file)")

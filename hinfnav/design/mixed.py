@@ -66,10 +66,11 @@ from ..lmi.robust_h2 import robust_h2_bound
 from ..lmi.solve import INFEASIBLE, SolverOptions
 from ..systems.uncertain import UncertainSystem
 from .arguments import system_argument
-from .result import SynthesisResult
+from .certify_loop import Check, solve_and_certify
+from .result import DesignResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
-__all__ = ["MIXED_SOLVER_OPTIONS", "MixedSynthesisResult", "MixedFront", "synthesize_mixed", "mixed_front",
+__all__ = ["MIXED_SOLVER_OPTIONS", "DesignResult", "MixedFront", "synthesize_mixed", "mixed_front",
            "front_gammas", "knee_index"]
 
 #: Default solver choices of the mixed synthesis: CVXOPT first. On these LMIs Clarabel stops with
@@ -78,64 +79,28 @@ __all__ = ["MIXED_SOLVER_OPTIONS", "MixedSynthesisResult", "MixedFront", "synthe
 MIXED_SOLVER_OPTIONS = SolverOptions(solvers=("CVXOPT", "CLARABEL"), polish=False, accuracy=1e-7)
 
 
-@dataclass(frozen=True, eq=False)
-class MixedSynthesisResult(SynthesisResult):
-    """A certified mixed H2/H∞ robust filter (12).
+#: What the certificate of a mixed design covers.
+COVERS_MIXED = ("every F with FᵀF ≤ I: the H∞ bound for time-varying F(k), the H2 bound ν for constant F (and the "
+                "asymptotic RMS of e under unit white noise for a time-varying one)")
 
-    The fields of :class:`SynthesisResult` keep their meaning (``gamma`` is
-    the certified worst-case H∞ bound, ``verified_norm`` the worst sampled
-    H∞ norm; ``lmi_gamma`` is the level imposed on the solver, ``inf`` for
-    the unconstrained H2 filter), plus:
 
-    Attributes
-    ----------
-    h2_bound : float
-        Certified ν: ``‖Ψ_F‖₂ ≤ h2_bound`` for every admissible constant F
-        (and the asymptotic RMS of e under unit white noise for a
-        time-varying one); the smaller of the two certificates below.
-    h2_lmi : float
-        The solver's ν, ``sqrt(trace W)``.
-    h2_synthesis_bound : float
-        ν certified by the synthesis LMI at the returned filter (its G, P₂, λ₂).
-    h2_analysis_bound : float
-        ν certified by the robust H2 analysis LMI of the returned filter.
-    h2_verified : float
-        Largest H2 norm of the error system over the samples (a lower bound
-        of the worst case); ≤ ``h2_bound``.
-    h2_sample_norms : ndarray, shape (k,)
-        H2 norm at each sample.
-    gamma_bound : float or None
-        The γ the design was asked to respect (None: unconstrained).
-    lyapunov : str
-        ``"extended"`` or ``"common"``.
-    """
-
-    h2_bound: float = float("nan")
-    h2_lmi: float = float("nan")
-    h2_synthesis_bound: float = float("nan")
-    h2_analysis_bound: float = float("nan")
-    h2_verified: float = float("nan")
-    h2_sample_norms: np.ndarray = None
-    gamma_bound: float = None
-    lyapunov: str = "extended"
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready numbers of the design (no matrices)."""
-        return {
-            "gamma_bound": self.gamma_bound,
-            "gamma": self.gamma,
-            "lmi_gamma": self.lmi_gamma if math.isfinite(self.lmi_gamma) else None,
-            "verified_norm": self.verified_norm,
-            "h2_bound": self.h2_bound,
-            "h2_lmi": self.h2_lmi,
-            "h2_synthesis_bound": self.h2_synthesis_bound,
-            "h2_analysis_bound": self.h2_analysis_bound,
-            "h2_verified": self.h2_verified,
-            "lyapunov": self.lyapunov,
-            "solver": self.solver,
-            "solve_time_s": self.solve_time_s,
-            "total_time_s": self.total_time_s,
-        }
+def mixed_row(result: DesignResult) -> dict[str, Any]:
+    """JSON-ready numbers of a mixed design (no matrices): one row of :meth:`MixedFront.table`."""
+    return {
+        "gamma_bound": result.gamma_bound,
+        "gamma": result.gamma,
+        "lmi_gamma": result.lmi_gamma if math.isfinite(result.lmi_gamma) else None,
+        "verified_norm": result.verified_norm,
+        "h2_bound": result.h2_bound,
+        "h2_lmi": result.h2_lmi,
+        "h2_synthesis_bound": result.h2_synthesis_bound,
+        "h2_analysis_bound": result.h2_analysis_bound,
+        "h2_verified": result.h2_verified,
+        "lyapunov": result.lyapunov,
+        "solver": result.solver,
+        "solve_time_s": result.solve_time_s,
+        "total_time_s": result.total_time_s,
+    }
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,11 +111,11 @@ class MixedFront:
     ----------
     gamma_star : float
         Certified H∞ optimum γ* (Corollary 1) the grid starts from.
-    results : tuple of MixedSynthesisResult
+    results : tuple of DesignResult
         One per γ of the grid, ascending.
-    h2_result : MixedSynthesisResult or None
+    h2_result : DesignResult or None
         The robust H2 filter without H∞ constraint.
-    hinf_result : SynthesisResult or None
+    hinf_result : DesignResult or None
         The H∞ optimum (Corollary 1).
     total_time_s : float
     """
@@ -186,7 +151,7 @@ class MixedFront:
         nus = self.nus
         return bool(np.all(nus[1:] <= nus[:-1] * (1.0 + rtol)))
 
-    def pareto(self) -> tuple[NDArray[np.float64], list[MixedSynthesisResult]]:
+    def pareto(self) -> tuple[NDArray[np.float64], list[DesignResult]]:
         """The Pareto front of the certified designs: at each γ of the grid, the best design certified at ≤ γ.
 
         Every design (the points and the unconstrained H2 design) is a
@@ -197,7 +162,7 @@ class MixedFront:
         Returns
         -------
         nus : ndarray, shape (k,)
-        designs : list of MixedSynthesisResult
+        designs : list of DesignResult
         """
         pool = list(self.results) + ([self.h2_result] if self.h2_result is not None else [])
         nus, designs = [], []
@@ -213,10 +178,10 @@ class MixedFront:
         return knee_index(self.gamma_bounds, self.pareto()[0])
 
     def table(self) -> list[dict[str, Any]]:
-        """One dict per point (:meth:`MixedSynthesisResult.as_dict`), the H2 point last."""
-        rows = [r.as_dict() for r in self.results]
+        """One dict per point (:func:`mixed_row`), the H2 point last."""
+        rows = [mixed_row(r) for r in self.results]
         if self.h2_result is not None:
-            rows.append(self.h2_result.as_dict())
+            rows.append(mixed_row(self.h2_result))
         return rows
 
 
@@ -309,6 +274,7 @@ class _Designer:
         scaling = options.state_scaling if isinstance(options.state_scaling, str) else np.array(options.state_scaling)
         self.P = prepare(system, self.structure, scaling, "general")
         self._problems = {}
+        self.certificate_calls = 0
 
     def problem(self, hinf):
         if hinf not in self._problems:
@@ -348,6 +314,7 @@ class _Designer:
         C_F = CFs / sig[None, :]
         Hbar = None if P.H is None else np.vstack([P.H, np.zeros_like(P.H)])
         analysis = robust_h2_bound(Abar, Bbar, Cbar, Hbar, Ebar)
+        self.certificate_calls += analysis.calls
         nu_c = min(nu, analysis.nu)
         if not np.isfinite(nu_c):
             return _Check(False, "the H2 Lyapunov LMI is not negative definite at the rebuilt filter for any κ",
@@ -357,8 +324,10 @@ class _Designer:
             gamma_c, _ = schur_gamma(M0, gamma_index(n, p, q))
         else:
             gamma_c = robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar, Ebar, solver="CVXOPT").gamma
+            self.certificate_calls += 1
             if not np.isfinite(gamma_c):
                 gamma_c = robust_bounded_real_lmi(Abar, Bbar, Cbar, Hbar, Ebar, solver="CLARABEL").gamma
+                self.certificate_calls += 1
         Si = 1.0 / sig
         scale2 = np.concatenate([Si, Si])
         variables = {
@@ -401,32 +370,48 @@ class _Designer:
     # -- one design -----------------------------------------------------------------
 
     def design(self, gamma):
+        """One certified design at the H∞ bound ``gamma`` (None: the robust H2 filter), through the one certify loop.
+
+        :func:`~hinfnav.design.certify_loop.solve_and_certify` minimises ν with
+        each solver (the problem compiled once, γ² a Parameter) and stops at the
+        first certified design (unless ``polish``); when rounding leaves a
+        solver's certified γ above the request, that solver solves once more at
+        ``γ (1 − 10 rtol)`` (the same loop, on that variant).
+        """
         t0 = time.perf_counter()
         gamma_req = None if gamma is None else as_positive("gamma", gamma)
         prob = self.problem(gamma_req is not None)
-        log, statuses, cands = [], [], []
-        seconds = 0.0
-        # the LMI is posed at γ; should rounding leave the certified γ above it, once more slightly inside
-        levels = [None] if gamma_req is None else [gamma_req, gamma_req * (1.0 - 10.0 * self.options.rtol)]
-        for slv in self.options.solvers:
-            for level in levels:
-                sol = prob.solve(None if level is None else level**2, slv, self.options.accuracy)
-                seconds += sol.seconds
-                statuses.append((slv, sol.status))
-                if sol.X is None:
+        opts = self.options
+        log, exceeded = [], []
+        self.certificate_calls = 0  # the robust H2 (and H∞) analysis LMIs the certificate solves
+
+        def variant(level):
+            def solve(slv, _level=None):
+                sol = prob.solve(None if level is None else level**2, slv, opts.accuracy)
+                if not sol.solved:
                     log.append(f"{slv}: status {sol.status}, no solution")
-                    break
-                chk = self.certify(sol, gamma_req)
-                at = "" if level is None else f" at γ = {level:.10g}"
-                log.append(f"{slv}{at}: status {sol.status}, solver ν = {math.sqrt(max(sol.nu2, 0.0)):.10g}, "
-                           f"certified ν = {chk.nu:.10g}, γ = {chk.gamma:.10g}: {chk.reason}")
-                if chk.ok:
-                    cands.append((chk, sol, slv))
-                if chk.ok or not chk.reason.startswith("certified γ"):
-                    break
-            if cands and not self.options.polish:
-                break
-        if not cands:
+                return sol
+            return solve
+
+        def certify(_, sol, level=None):
+            chk = self.certify(sol, gamma_req)
+            at = "" if level is None else f" at γ = {level:.10g}"
+            log.append(f"{sol.solver}{at}: status {sol.status}, solver ν = {math.sqrt(max(sol.nu2, 0.0)):.10g}, "
+                       f"certified ν = {chk.nu:.10g}, γ = {chk.gamma:.10g}: {chk.reason}")
+            if chk.reason.startswith("certified γ"):
+                exceeded.append(sol.solver)
+            return Check(chk.ok, chk.nu, chk.reason, chk)  # the level the loop compares is ν
+
+        run = solve_and_certify([("at γ", variant(gamma_req))], list(opts.solvers),
+                                lambda v, sol: certify(v, sol, gamma_req), method="minimize", polish=opts.polish,
+                                rtol=opts.rtol)
+        if gamma_req is not None and exceeded and (opts.polish or not run.candidates):
+            inside = gamma_req * (1.0 - 10.0 * opts.rtol)
+            solve_and_certify([("just inside γ", variant(inside))], list(exceeded),
+                              lambda v, sol: certify(v, sol, inside), method="minimize", polish=opts.polish,
+                              rtol=opts.rtol, loop=run)
+        statuses = run.statuses
+        if not run.candidates:
             what = "γ = " + ("∞ (H2 only)" if gamma_req is None else f"{gamma_req:.10g}")
             if any(st in INFEASIBLE or st.startswith("infeasible") for _, st in statuses):
                 raise InfeasibleLMIError(
@@ -436,17 +421,18 @@ class _Designer:
                 )
             raise CertificationError(f"no solution of the mixed H2/H∞ LMIs at {what} passed certification: "
                                      + " | ".join(log))
-        chk, sol, slv = min(cands, key=lambda c: c[0].nu)
-        return self._result(chk, sol, slv, gamma_req, seconds, tuple(log), time.perf_counter() - t0)
+        best = run.best()
+        return self._result(best.check.data, best.sol, best.solver, gamma_req, run.seconds, tuple(log),
+                            time.perf_counter() - t0, run.calls + self.certificate_calls)
 
-    def _result(self, chk, sol, slv, gamma_req, seconds, log, total):
+    def _result(self, chk, sol, slv, gamma_req, seconds, log, total, calls):
         ss = self.sample_set
-        return MixedSynthesisResult(
+        return DesignResult(
             A_F=chk.A_F, B_F=chk.B_F, C_F=chk.C_F,
             gamma=float(chk.gamma), lmi_gamma=float("inf") if gamma_req is None else float(gamma_req),
             verified_norm=chk.wc.norm, sample_norms=chk.wc.norms, worst_sample=chk.wc.index,
             spectral_radius=float(np.max(chk.wc.spectral_radii)), solver=slv, solve_time_s=seconds,
-            total_time_s=total, method="h2-minimize", dt=self.dt, variables=chk.variables, attempts=log,
+            total_time_s=total, method="h2-minimize", dt=self.dt, witness=chk.variables, attempts=log,
             structure=self.structure, samples=tuple(self.samples),
             uncertainty_bound=None if ss is None else ss.bound, sample_values=None if ss is None else ss.values,
             form="general", sample_labels=() if ss is None else ss.labels,
@@ -454,6 +440,7 @@ class _Designer:
             h2_synthesis_bound=float(chk.nu_synthesis), h2_analysis_bound=float(chk.nu_analysis),
             h2_verified=float(np.max(chk.h2_norms)), h2_sample_norms=chk.h2_norms,
             gamma_bound=None if gamma_req is None else float(gamma_req), lyapunov=self.lyapunov,
+            system=self.system, solver_calls=calls, objective="mixed", covers=COVERS_MIXED,
         )
 
 
@@ -484,7 +471,7 @@ _DOC_PARAMS = """
 def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float | None = None, structure: str = "full",
                      uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                      seed: int | np.random.Generator = 0, lyapunov: str = "extended", options: SolverOptions | None = None,
-                     solver: str | None = None, **legacy: Any) -> MixedSynthesisResult:
+                     solver: str | None = None, **legacy: Any) -> DesignResult:
     """Robust mixed H2/H∞ filter: minimize the certified worst-case H2 norm ν subject to the H∞ bound γ.
 
     Parameters
@@ -496,7 +483,10 @@ def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float
 
     Returns
     -------
-    MixedSynthesisResult
+    DesignResult
+        With ``objective="mixed"``, the certified H2 bound ``h2_bound`` (and
+        ``h2_lmi``, ``h2_synthesis_bound``, ``h2_analysis_bound``,
+        ``h2_verified``, ``h2_sample_norms``) and the requested ``gamma_bound``.
 
     Raises
     ------
@@ -526,8 +516,8 @@ def mixed_front(system: UncertainSystem, *matrices: ArrayLike, gammas: Sequence[
                 structure: str = "full", uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None,
                 n_random_samples: int = 4, seed: int | np.random.Generator = 0, lyapunov: str = "extended",
                 options: SolverOptions | None = None, solver: str | None = None, gamma_star: float | None = None,
-                hinf_result: SynthesisResult | None = None,
-                progress: Callable[[MixedSynthesisResult], object] | None = None, **legacy: Any) -> MixedFront:
+                hinf_result: DesignResult | None = None,
+                progress: Callable[[DesignResult], object] | None = None, **legacy: Any) -> MixedFront:
     """Certified mixed designs along a γ grid (one compiled problem, re-solved per γ).
 
     Parameters
@@ -538,7 +528,7 @@ def mixed_front(system: UncertainSystem, *matrices: ArrayLike, gammas: Sequence[
         Also design the unconstrained robust H2 filter (the end of the front).
     gamma_star : float, optional
         γ* to record (default: the smallest γ of the grid).
-    hinf_result : SynthesisResult, optional
+    hinf_result : DesignResult, optional
         The H∞ optimum to keep with the front.
     progress : callable, optional
         Called with each result as it is certified.

@@ -24,9 +24,9 @@ time (a Lyapunov function ``ξᵀ(Σ αᵢ Pᵢ)ξ`` for each α).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import Any
 
 import control
@@ -46,10 +46,10 @@ from ..systems.uncertain import UncertainSystem
 from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
 from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
-from .certify_loop import solve_and_certify
-from .result import FilterDesign, SynthesisResult
+from .certify_loop import Check, solve_and_certify
+from .result import COVERS_NOMINAL, DesignResult
 
-__all__ = ["LYAPUNOV", "COVERS", "PolytopicResult", "synthesize_polytopic", "certify_polytopic",
+__all__ = ["LYAPUNOV", "COVERS", "synthesize_polytopic", "certify_polytopic",
            "sampled_norms", "error_coordinates", "observer_nominal"]
 
 #: Lyapunov structures :func:`synthesize_polytopic` accepts.
@@ -61,61 +61,6 @@ COVERS = {
     "parameter-dependent": "every α constant in time in the simplex (uncertainty constant in time; "
                            "Lyapunov matrix Σ αᵢ Pᵢ)",
 }
-
-
-@dataclass(frozen=True, eq=False)
-class PolytopicResult(FilterDesign):
-    """A certified H∞ filter for a polytopic system.
-
-    Attributes
-    ----------
-    A_F, B_F, C_F : ndarray
-        The filter ``x_f⁺ = A_F x_f + B_F y``, ``z_f = C_F x_f``.
-    gamma : float
-        Certified level: (E1) positive definite in float64 at every vertex at
-        the returned filter and witness.
-    lmi_gamma : float
-        The solver's γ.
-    verified_norm : float
-        Largest sampled H∞ norm of the error system (a lower bound of the worst case).
-    sample_norms : ndarray, shape (K,)
-    alphas : ndarray, shape (K, N)
-        The convex weights sampled (vertices, lattice, random points).
-    worst_sample : int
-    spectral_radius : float
-        Largest spectral radius of the (error-coordinate) error system over the samples.
-    lyapunov, form, covers : str
-    witness : dict
-        ``P`` (list of arrays, one per vertex) and ``G``: the LMI variables
-        that :func:`certify_polytopic` re-checks.
-    solver : str
-    solve_time_s, total_time_s : float
-    dt : float
-    attempts : tuple of str
-    system : PolytopicSystem or None
-        The polytope the filter was designed for.
-    objective : {"hinf", "h2"}
-        With ``"h2"``, ``gamma``, ``lmi_gamma``, ``verified_norm`` and
-        ``sample_norms`` are H2 norms (bound and sampled), ``witness`` has W.
-    solver_calls : int
-        Solver invocations of the design.
-    """
-
-    alphas: np.ndarray
-    worst_sample: int
-    spectral_radius: float
-    lyapunov: str
-    form: str
-    covers: str
-    witness: dict = field(default_factory=dict)
-    solver: str = ""
-    solve_time_s: float = 0.0
-    total_time_s: float = 0.0
-    dt: float = 1.0
-    attempts: tuple = ()
-    system: object = None
-    objective: str = "hinf"
-    solver_calls: int = 0
 
 
 def _vertex_tuples(system):
@@ -245,7 +190,7 @@ def _check(system, form):
 
 def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-dependent", form: str = "general",
                          solver: str | None = None, grid_points: int | None = None, seed: int | np.random.Generator = 0,
-                         objective: str = "hinf") -> PolytopicResult:
+                         objective: str = "hinf") -> DesignResult:
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters
@@ -273,7 +218,10 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     Returns
     -------
-    PolytopicResult
+    DesignResult
+        With ``uncertainty="polytope"``, ``lyapunov``, ``covers``, ``alphas``
+        (the convex weights sampled) and ``witness`` (``P`` per vertex, ``G``;
+        ``W`` for H2) that :func:`certify_polytopic` re-checks.
 
     Raises
     ------
@@ -304,7 +252,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     def certify(_, sol):
         out = _rebuild_and_certify(system, sol.as_dict(), form, alphas, objective)
-        return _PolyCheck(out[-1], out[0], "certified" if out[-1] else "not certified", out)
+        return Check(out[-1], out[0], "certified" if out[-1] else "not certified", out)
 
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
@@ -331,8 +279,8 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         raise CertificationError("no solution of the extended LMIs passed certification: " + " | ".join(log))
     (gamma_c, A_F, B_F, C_F, witness, norms, radii, ok), _, slv, g_s = best
     k = int(np.argmax(norms))
-    return PolytopicResult(
-        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(gamma_c), lmi_gamma=g_s, verified_norm=float(norms[k]),
+    return DesignResult(
+        A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(gamma_c), lmi_gamma=g_s, uncertainty="polytope", verified_norm=float(norms[k]),
         sample_norms=norms, alphas=alphas, worst_sample=k, spectral_radius=float(np.max(radii)),
         lyapunov=lyapunov, form=form, covers=COVERS[lyapunov], witness=witness, solver=slv,
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
@@ -355,8 +303,9 @@ def _augmented_result(system, lyapunov, solvers, alphas, t0):
                                  + " | ".join(out["log"] or out["statuses"]))
     norms, k = out["norms"], int(np.argmax(out["norms"]))
     states = ", ".join(f"x[{j}]" for j in out["part"].states)
-    return PolytopicResult(
+    return DesignResult(
         A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=out["lmi_gamma"],
+        uncertainty="polytope", solver_calls=out["calls"],
         verified_norm=float(norms[k]), sample_norms=norms, alphas=alphas, worst_sample=k,
         spectral_radius=float(np.max(out["radii"])), lyapunov=lyapunov, form="observer",
         covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"
@@ -374,22 +323,15 @@ def _cells_result(system, lyapunov, solvers, t0):
         raise CertificationError("no general-form solution of (E1) on the cells passed certification (solver status: "
                                  + "; ".join(out["statuses"]) + "): " + " | ".join(out["log"]))
     norms, k = out["norms"], int(np.argmax(out["norms"]))
-    return PolytopicResult(
+    return DesignResult(
         A_F=out["A_F"], B_F=out["B_F"], C_F=out["C_F"], gamma=float(out["gamma"]), lmi_gamma=out["lmi_gamma"],
+        uncertainty="polytope", solver_calls=out["calls"],
         verified_norm=float(norms[k]), sample_norms=norms, alphas=out["alphas"], worst_sample=k,
         spectral_radius=float(np.max(out["radii"])), lyapunov=lyapunov, form="general",
         covers=COVERS[lyapunov].replace("in the simplex", "in the simplex of each cell (the union of the cells' hulls)"),
         witness=out["witness"], solver=out["solver"], solve_time_s=out["seconds"],
         total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(out["log"]), system=system,
         objective="hinf")
-@dataclass
-class _PolyCheck:
-    """What the certify loop needs of a polytopic certificate (internal)."""
-
-    ok: bool
-    gamma: float
-    reason: str
-    data: tuple
 
 
 def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):
@@ -419,7 +361,7 @@ def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):
 
 
 def observer_nominal(system, dt, solvers, t_start):
-    """Nominal observer-form filter of a plant that need not be stable, as a :class:`SynthesisResult`.
+    """Nominal observer-form filter of a plant that need not be stable, as a norm-bounded :class:`DesignResult`.
 
     The estimation error ``e⁺ = (A + B_F C) e + B w + B_F D v`` does not
     contain the plant state, so only (A, C) detectable is needed; designed by
@@ -431,13 +373,10 @@ def observer_nominal(system, dt, solvers, t_start):
     system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, dt=1.0 if dt is True else dt)
     poly = PolytopicSystem((system,), system.dt)
     res = synthesize_polytopic(poly, lyapunov="common", form="observer", solver=solvers[0] if len(solvers) == 1 else None)
-    return SynthesisResult(
-        A_F=res.A_F, B_F=res.B_F, C_F=res.C_F, gamma=res.gamma, lmi_gamma=res.lmi_gamma,
-        verified_norm=res.verified_norm, sample_norms=res.sample_norms, worst_sample=0,
-        spectral_radius=res.spectral_radius, solver=res.solver, solve_time_s=res.solve_time_s,
-        total_time_s=time.perf_counter() - t_start, method="minimize", dt=dt,
-        variables={"P": res.witness["P"], "G": res.witness["G"], "lyapunov": "common",
-                   "coordinates": "estimation error e = x + x_f (observer form)"},
+    return dataclasses.replace(
+        res, worst_sample=0, total_time_s=time.perf_counter() - t_start, method="minimize", dt=dt,
+        witness={"P": res.witness["P"], "G": res.witness["G"], "lyapunov": "common",
+                 "coordinates": "estimation error e = x + x_f (observer form)"},
         attempts=res.attempts + ("nominal observer form in error coordinates: the plant need not be stable",),
-        samples=(None,), form="observer", system=system,
+        samples=(None,), system=system, uncertainty="norm-bounded", alphas=None, covers=COVERS_NOMINAL,
     )

@@ -23,7 +23,7 @@ from ..core.exceptions import InputError
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..systems.polytopic import PolytopicSystem
 from .io import load_design
-from .polytopic import COVERS, PolytopicResult, certify_polytopic, sampled_norms
+from .polytopic import COVERS, certify_polytopic, sampled_norms
 from .samples import default_uncertainty_samples
 
 __all__ = ["recertify"]
@@ -33,7 +33,7 @@ _RTOL = 1e-6
 
 def _lmi_levels(result, system):
     """LMI levels certifiable from the saved witness of a norm-bounded/nominal design: {name: γ}."""
-    w, out = result.variables, {}
+    w, out = result.witness, {}
     if "G" in w and "P" in w:  # nominal observer form in error coordinates
         poly = PolytopicSystem((system,), system.dt)
         out["extended BRL (E1), error coordinates"] = certify_polytopic(poly, result.A_F, result.B_F, result.C_F,
@@ -93,7 +93,8 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
     """
     result, system, d = load_design(path)
     reasons = []
-    if isinstance(result, PolytopicResult):
+    polytopic = result.uncertainty == "polytope"
+    if polytopic:
         name = "extended H2 LMIs (E2)" if result.objective == "h2" else "extended BRL (E1)"
         levels = {f"{name} at every vertex": certify_polytopic(system, result.A_F, result.B_F, result.C_F,
                                                                result.witness, result.form)[0]}
@@ -107,7 +108,7 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
                                         result.objective, witness=result.witness)
     else:
         levels = _lmi_levels(result, system)
-        if "G" in result.variables:
+        if "G" in result.witness:
             poly = PolytopicSystem((system,), system.dt)
             norms, radii, _ = sampled_norms(poly, result.A_F, result.B_F, result.C_F, "observer")
         else:
@@ -133,9 +134,9 @@ def recertify(path: str | os.PathLike[str]) -> dict[str, Any]:
         "lmi_gamma_recomputed": float(best),
         "sampled_worst_norm": worst,
         "n_samples": int(np.size(norms)),
-        "covers": (COVERS[proven] if isinstance(result, PolytopicResult) and proven != result.lyapunov
+        "covers": (COVERS[proven] if polytopic and proven != result.lyapunov
                    else d["certificate"].get("covers", "")),
-        "lyapunov_proven": proven if isinstance(result, PolytopicResult) else "common",
-        "objective": getattr(result, "objective", "hinf"),
+        "lyapunov_proven": proven if polytopic else "common",
+        "objective": result.objective,
         "reasons": reasons,
     }

@@ -78,7 +78,7 @@ from ..systems.uncertain import UncertainSystem
 from .arguments import system_argument
 from .explain import infeasibility_hint
 from .polytopic import observer_nominal
-from .result import SynthesisResult
+from .result import COVERS_NOMINAL, COVERS_NORM_BOUNDED, DesignResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 from .certify_loop import Candidate, solve_and_certify
 from .tighten import LOOSE_FACTOR, full_lyapunov_gamma, is_loose
@@ -209,7 +209,7 @@ def _best_sampled(run):
 def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "full",
                uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                seed: int | np.random.Generator = 0, form: str = "general", options: SolverOptions | None = None,
-               solver: str | None = None, **legacy: Any) -> SynthesisResult:
+               solver: str | None = None, **legacy: Any) -> DesignResult:
     """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
 
     Parameters
@@ -219,7 +219,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
         ``y = C x + D v``, ``z = L x``, ``FᵀF ≤ I`` (no H, E, or zero ones:
         the nominal H∞ filter). A must be Schur stable for every admissible
         F. Its ``dt`` (s) is the sampling time of the result's
-        :meth:`SynthesisResult.statespace`. Deprecated until 0.3: the loose
+        :meth:`DesignResult.statespace`. Deprecated until 0.3: the loose
         matrices ``A, B, C, D, L[, H, E]`` with ``dt=`` (float, or True:
         discrete, unspecified), with a :class:`DeprecationWarning`
         (:func:`hinfnav.design.arguments.system_argument`).
@@ -252,7 +252,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
 
     Returns
     -------
-    SynthesisResult
+    DesignResult
 
     Raises
     ------
@@ -319,7 +319,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     returned ``gamma`` is that of the filter itself, certified with a full
     Lyapunov matrix (the robust bounded real LMI of Lemmas 1–3 with the
     filter fixed, :func:`hinfnav.design.tighten.full_lyapunov_gamma`), the
-    smaller of the two. ``variables["lmi20_gamma"]`` keeps the level of (20)
+    smaller of the two. ``witness["lmi20_gamma"]`` keeps the level of (20)
     and ``lmi_gamma`` the solver's; on Sun et al. (2011)'s model the
     restriction costs 0.03 % (δ̄ = 0.05) to 3 % (δ̄ = 5) in (20), while
     the filters themselves certify within 3e-8 of γ* at δ̄ = 0.05.
@@ -436,7 +436,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
                 LooseBoundWarning,
                 stacklevel=2,
             )
-        return SynthesisResult(
+        return DesignResult(
             A_F=chk.A_F,
             B_F=chk.B_F,
             C_F=chk.C_F,
@@ -451,7 +451,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
             total_time_s=time.perf_counter() - t_start,
             method=how,
             dt=dt_value,
-            variables=chk.variables,
+            witness=chk.variables,
             attempts=tuple(run.log),
             structure=structure,
             samples=tuple(checked_samples),
@@ -461,6 +461,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
             sample_labels=() if sample_set is None else sample_set.labels,
             system=system,
             solver_calls=run.calls,
+            covers=COVERS_NORM_BOUNDED if system.H is not None else COVERS_NOMINAL,
         )
     if "infeasible" in run.verdicts and "feasible" not in run.verdicts:
         hint = infeasibility_hint(system.A, system.H, system.E, structure, form)

@@ -49,6 +49,18 @@ class MixedSolution:
     lam_inf: float = 0.0
     W: np.ndarray = None
     seconds: float = 0.0
+    calls: int = 0
+    solver: str = ""
+
+    @property
+    def solved(self) -> bool:
+        """Whether the solver returned a point."""
+        return self.X is not None
+
+    @property
+    def gamma2(self) -> float:
+        """The level this problem minimises, ν² (the name :func:`hinfnav.design.certify_loop.solve_and_certify` reads)."""
+        return self.nu2
 
 
 def _sym(M):
@@ -132,13 +144,13 @@ class MixedProblem:
         """
         if self.hinf:
             self.gamma2.value = float(gamma2)
-        status, seconds, _ = run_solver(self.problem, solver, accuracy)
+        status, seconds, calls = run_solver(self.problem, solver, accuracy)
         if status.startswith("solver error"):
-            return MixedSolution(status, float("nan"), seconds=seconds)
+            return MixedSolution(status, float("nan"), seconds=seconds, calls=calls, solver=solver)
         v = self._vars
         status = str(self.problem.status)
         if v["X"].value is None or v["W"].value is None:
-            return MixedSolution(status, float("nan"), seconds=seconds)
+            return MixedSolution(status, float("nan"), seconds=seconds, calls=calls, solver=solver)
 
         def val(x):
             if isinstance(x, float):
@@ -163,4 +175,6 @@ class MixedProblem:
             val(v["lam_inf"]),
             _sym(val(v["W"])),
             seconds,
+            calls,
+            solver,
         )

@@ -20,6 +20,7 @@ Lyapunov matrix for the filter found.
 """
 
 import math
+import dataclasses
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -48,6 +49,8 @@ class H2Certificate:
     kappa : float
         Level of the output block at which the LMI was certified.
     status : str
+    calls : int
+        Solver invocations it took (one per solver tried).
     """
 
     nu: float
@@ -56,6 +59,7 @@ class H2Certificate:
     lam: float
     kappa: float
     status: str
+    calls: int = 1
 
 
 def _certify(Abar, Bbar, Cbar, Hbar, Ebar, P, lam):
@@ -94,14 +98,15 @@ def robust_h2_bound(Abar, Bbar, Cbar, Hbar=None, Ebar=None, solver=None, margin=
     H2Certificate
     """
     Abar, Bbar, Cbar, Hbar, Ebar = error_system_matrices(Abar, Bbar, Cbar, Hbar, Ebar)
-    best = None
+    best, calls = None, 0
     for slv in ("CVXOPT", "CLARABEL") if solver is None else (solver,):
         cert = _once(Abar, Bbar, Cbar, Hbar, Ebar, slv, margin, bound, accuracy)
+        calls += 1
         if best is None or cert.nu < best.nu:
             best = cert
         if solver is None and np.isfinite(best.nu):
             break
-    return best
+    return dataclasses.replace(best, calls=calls)
 
 
 def _once(Abar, Bbar, Cbar, Hbar, Ebar, solver, margin, bound, accuracy):

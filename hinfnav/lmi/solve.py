@@ -178,6 +178,14 @@ class Solution:
             return 0.0
         raise AttributeError(f"Solution has no value {name!r}")
 
+    @classmethod
+    def from_dict(cls, out: dict, solver: str) -> Solution:
+        """The solution of a problem built in a single shot: :func:`solve_once`'s dict plus the values read into it."""
+        head = ("status", "gamma2", "seconds", "calls", "margin")
+        values = {k: v for k, v in out.items() if k not in head}
+        return cls(out["status"], out["gamma2"], values, out.get("margin", float("nan")), out["seconds"], solver,
+                   out.get("calls", 1))
+
     def as_dict(self) -> dict:
         """``status``, ``gamma2``, ``seconds``, and when solved ``margin`` and the values (a flat dict)."""
         out = {"status": self.status, "gamma2": self.gamma2, "seconds": self.seconds}
@@ -251,21 +259,21 @@ def solve_once(cons: list, level: Any, solver: str, accuracy: float | None, t: A
     -------
     dict
         ``status`` (cvxpy's, or ``"solver error (...)"``), ``gamma2`` (the
-        solver's minimum, or ``gamma2``; NaN without a solution) and
-        ``seconds``.
+        solver's minimum, or ``gamma2``; NaN without a solution),
+        ``seconds`` and ``calls`` (solver invocations: 1).
     """
     if gamma2 is None:
         prob = cp.Problem(cp.Minimize(level), cons)
     else:
         prob = cp.Problem(cp.Maximize(t), list(cons) + [t <= 1e-3 * min(1.0, float(gamma2))])
-    status, seconds, _ = run_solver(prob, solver, accuracy, retry=False)
+    status, seconds, calls = run_solver(prob, solver, accuracy, retry=False)
     if status.startswith("solver error"):
         g2 = float("nan")
     elif gamma2 is None:
         g2 = float(level.value) if level.value is not None else float("nan")
     else:
         g2 = float(gamma2)
-    return {"status": status, "gamma2": g2, "seconds": seconds}
+    return {"status": status, "gamma2": g2, "seconds": seconds, "calls": calls}
 
 
 def solve_once_gamma(cons: list, g2: Any, solver: str, accuracy: float | None) -> dict[str, Any]:

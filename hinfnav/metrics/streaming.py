@@ -34,7 +34,7 @@ from .accumulator import StatisticsSink, WindowStatistics
 from .consistency import NIS_KEYS, warn_if_diverged
 
 if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
     from ..estimators.base import Estimator
     from ..noise import NoiseModel
 
@@ -71,7 +71,7 @@ class MonteCarloStatistics:
         return self.windows[name]
 
 
-def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | SynthesisResult, *, windows: Mapping[str, Sequence[float]],
+def monte_carlo_statistics(scenario: Any, estimator: str | Estimator | DesignResult, *, windows: Mapping[str, Sequence[float]],
                            runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, noise: str | NoiseModel = "gaussian",
                            measurement_noise: str | NoiseModel | None = None, batch_size: int = 100, progress: bool = False,
                            tol: ArrayLike | None = None, backend: str | None = None,

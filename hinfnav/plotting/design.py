@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from matplotlib.artist import Artist
     from matplotlib.axes import Axes
 
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
 
 __all__ = [
     "GAIN_LABEL",
@@ -82,7 +82,7 @@ def plot_sigma(sys: control.StateSpace, *, ax: Axes, label: str | None = None, o
     Parameters
     ----------
     sys : control.StateSpace
-        Discrete error system (e.g. :meth:`SynthesisResult.error_system`).
+        Discrete error system (e.g. :meth:`DesignResult.error_system`).
     ax : matplotlib.axes.Axes
     label : str, optional
     omega : array_like, optional
@@ -121,13 +121,13 @@ def plot_sigma(sys: control.StateSpace, *, ax: Axes, label: str | None = None, o
     return artists
 
 
-def plot_worst_case_over_delta(result: SynthesisResult, *, ax: Axes, label: str | None = None,
+def plot_worst_case_over_delta(result: DesignResult, *, ax: Axes, label: str | None = None,
                                **line_kw: Any) -> list[Artist]:
     """H∞ norm of the error system at each δ of the certification grid.
 
     Parameters
     ----------
-    result : hinfnav.synthesis.SynthesisResult
+    result : hinfnav.design.DesignResult
         From :func:`hinfnav.synthesis.design_for_scenario` (``deltas`` set).
     ax : matplotlib.axes.Axes
     label : str, optional

@@ -22,7 +22,7 @@ from ..core.exceptions import InputError
 from .engine import HistorySink, resolve_estimator, run_monte_carlo
 
 if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
     from ..estimators.base import Estimator
     from ..noise import NoiseModel
     from .result import SimulationResult
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 __all__ = ["simulate_closed_loop"]
 
 
-def simulate_closed_loop(scenario: Any, estimator: str | Estimator | SynthesisResult, controller: LinearFeedback | None = None, *,
+def simulate_closed_loop(scenario: Any, estimator: str | Estimator | DesignResult, controller: LinearFeedback | None = None, *,
                          noise: str | NoiseModel = "gaussian", measurement_noise: str | NoiseModel | None = None, runs: int = 1,
                          seed: int | np.random.SeedSequence | np.random.Generator = 0, P0: ArrayLike | None = None, progress: bool = False,
                          batch_size: int = 100, keep_covariance: bool | str = False, diagnostics: bool = False,

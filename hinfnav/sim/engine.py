@@ -68,7 +68,7 @@ from .stepped import EstimatorStage, ModelPlant, run_stepped
 from .truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, scenario_truth_model, simulate_truth
 
 if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
     from ..noise import NoiseModel
     from ..systems.measurements import MeasurementModel
 
@@ -109,15 +109,15 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
 
 def _names_estimators(value: Any) -> bool:
     """Whether ``value`` is what came first in ``resolve_estimator(s)``'s earlier order: estimators, never a scenario."""
-    design = getattr(sys.modules.get("hinfnav.design.result"), "SynthesisResult", ())  # no design without its module
+    design = getattr(sys.modules.get("hinfnav.design.result"), "DesignResult", ())  # no design without its module
     return isinstance(value, (str, Estimator, Mapping, Sequence, design))
 
 
 @scenario_moved("estimator", "scenario", was=_names_estimators)
-def resolve_estimator(scenario: Any, estimator: str | Estimator | SynthesisResult) -> Estimator:
+def resolve_estimator(scenario: Any, estimator: str | Estimator | DesignResult) -> Estimator:
     """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a name for ``scenario``, or built from a design.
 
-    A :class:`~hinfnav.design.SynthesisResult` is turned into an estimator by
+    A :class:`~hinfnav.design.DesignResult` is turned into an estimator by
     the scenario's ``estimator_from_design`` (which checks that it was
     designed for this scenario's sampling time).
     """
@@ -304,7 +304,7 @@ def run_monte_carlo(scenario: Any, estimators: Any, *, sink: Sink, runs: int = 1
     ----------
     scenario : scenario object
         ``truth_model(**conditions)`` and ``xhat0``, or its own ``simulate_truth`` (module docstring).
-    estimators : Estimator, str, SynthesisResult, sequence of them, or mapping name → one of them
+    estimators : Estimator, str, DesignResult, sequence of them, or mapping name → one of them
         All run on the same truths (open loop) or the same noise draws (closed loop).
     sink : Sink
         Receives each batch (:class:`HistorySink`, :class:`hinfnav.metrics.StatisticsSink`).

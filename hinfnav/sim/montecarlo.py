@@ -37,7 +37,7 @@ from .result import SimulationResult
 from .truth import scenario_truth_model
 
 if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
     from ..noise import NoiseModel
     from .truth import Truth
 
@@ -66,7 +66,7 @@ def run_estimator(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P0: A
     return sink.result()[name]
 
 
-def simulate_batches(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+def simulate_batches(scenario: Any, estimator: str | Estimator | DesignResult, *, noise: str | NoiseModel = "gaussian",
                      measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0,
                      batch_size: int = 100, diagnostics: bool | Sequence[str] = False,
                      keep_covariance: bool | str = True, **conditions: Any) -> Iterator[tuple[int, SimulationResult]]:
@@ -122,7 +122,7 @@ def check_history_memory(scenario: Any, runs: int, *, fraction: float = 0.8, **c
     return need
 
 
-def simulate(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+def simulate(scenario: Any, estimator: str | Estimator | DesignResult, *, noise: str | NoiseModel = "gaussian",
              measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0, batch_size: int = 100,
              progress: bool = False, keep_covariance: bool | str = True, diagnostics: bool | Sequence[str] = NIS_KEYS,
              backend: str | None = None, **conditions: Any) -> SimulationResult:

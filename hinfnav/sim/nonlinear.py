@@ -19,7 +19,7 @@ from .montecarlo import run_estimator, simulate
 from .truth import simulate_truth
 
 if TYPE_CHECKING:
-    from ..design.result import SynthesisResult
+    from ..design.result import DesignResult
     from ..estimators.base import Estimator
     from ..noise import NoiseModel
     from .result import SimulationResult
@@ -43,7 +43,7 @@ def run_on_truth(estimator: Estimator, truth: Truth, xhat0: ArrayLike, *, P0: Ar
     return run_estimator(estimator, truth, xhat0, P0=P0, keep_covariance=keep_covariance, diagnostics=diagnostics)
 
 
-def simulate_nonlinear(scenario: Any, estimator: str | Estimator | SynthesisResult, *, noise: str | NoiseModel = "gaussian",
+def simulate_nonlinear(scenario: Any, estimator: str | Estimator | DesignResult, *, noise: str | NoiseModel = "gaussian",
                        measurement_noise: str | NoiseModel | None = None, runs: int = 1, seed: int | np.random.SeedSequence | np.random.Generator = 0,
                        batch_size: int = 100, progress: bool = False, keep_covariance: bool | str = False,
                        diagnostics: bool | Sequence[str] = False, **conditions: Any) -> SimulationResult:

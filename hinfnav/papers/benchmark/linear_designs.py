@@ -51,7 +51,7 @@ from ...analysis.riccati import steady_state_kalman
 from ...core.exceptions import HinfnavError, InputError
 from ...core.linalg import spectral_radius
 from ...core.validation import as_nonnegative
-from ...design.result import SynthesisResult
+from ...design.result import DesignResult
 from ...design.robust_hinf import synthesize
 from ...estimators.lti import LTIFilter
 from ...estimators.recursive_hinf import ExtendedHInfinityFilter, RecursiveHInfinityFilter
@@ -151,7 +151,7 @@ class LinearDesign:
         The readings' noise σ the design divided them by.
     gamma : float
         Certified H∞ level from (w, v) to W⁻¹ e (dimensionless).
-    result : SynthesisResult
+    result : DesignResult
         The synthesis in the scaled coordinates (solver, times, certificate).
     """
 
@@ -161,7 +161,7 @@ class LinearDesign:
     weights: np.ndarray
     output_scale: np.ndarray
     gamma: float
-    result: SynthesisResult
+    result: DesignResult
 
 
 def _key(system, meas):

@@ -70,7 +70,7 @@ def closed_loop_study(scenario=None, *, runs=20, seed=0, noise="gaussian", desig
     runs : int
     seed : int
     noise : str
-    designed : SynthesisResult, optional
+    designed : DesignResult, optional
         The observer-form design at the scenario's δ̄ (designed here when None).
     arrive_m : float
         Range below which the chaser counts as arrived, m (default 5 m: the

@@ -14,7 +14,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import control
 import numpy as np
@@ -31,7 +31,7 @@ from ...io.progress import bar_disabled
 from ...io.provenance import provenance
 from ...core.validation import as_int_at_least, as_nonnegative, check_keywords
 from ...design import io as design_io
-from ...design.result import SynthesisResult
+from ...design.result import DesignResult
 from ...design.robust_hinf import synthesize
 from ...design.samples import SampleSet
 from ...lmi.conditioning import prepare_uncertainty
@@ -40,9 +40,6 @@ from ...systems.hill import uncertainty_F
 from .arguments import scenario_first, scenario_keyword
 from .constants import DEFAULT_DELTA_BARS, published_filter
 from .scenario import Scenario
-
-if TYPE_CHECKING:
-    from ...design.polytopic import PolytopicResult
 
 __all__ = [
     "delta_grid",
@@ -106,7 +103,7 @@ def _samples(delta_bar, points):
 
 
 def design_for_scenario(scenario: Scenario | None = None, delta_bar: float | None = None, *, delta_points: int = 21,
-                        **options: Any) -> SynthesisResult:
+                        **options: Any) -> DesignResult:
     """Design the robust filter for a scenario's closed-loop model at δ̄.
 
     Builds ψ_d from ``scenario.design_model(delta_bar)`` (A = I + T(A₁ + G₀K),
@@ -129,7 +126,7 @@ def design_for_scenario(scenario: Scenario | None = None, delta_bar: float | Non
 
     Returns
     -------
-    SynthesisResult
+    DesignResult
         With ``uncertainty_bound`` = δ̄ and ``sample_values`` = the δ grid,
         ``dt = scenario.dt``.
     """
@@ -166,7 +163,7 @@ class GammaSweep:
     Attributes
     ----------
     delta_bars : ndarray, shape (k,)
-    results : tuple of SynthesisResult
+    results : tuple of DesignResult
     """
 
     delta_bars: np.ndarray
@@ -281,7 +278,7 @@ def design_report_from(res):
         "form": res.form,
         "gamma": res.gamma,
         "lmi_gamma": res.lmi_gamma,
-        "lmi20_gamma": float(res.variables.get("lmi20_gamma", res.gamma)),
+        "lmi20_gamma": float(res.witness.get("lmi20_gamma", res.gamma)),
         "verified_norm": res.verified_norm,
         "worst_delta": res.worst_value,
         "spectral_radius": res.spectral_radius,
@@ -346,7 +343,7 @@ def format_design_report(report):
 
 
 def compare_with_published(scenario: Scenario | None = None, solver: str | None = None, delta_points: int = 21,
-                           design: SynthesisResult | None = None) -> dict[str, Any]:
+                           design: DesignResult | None = None) -> dict[str, Any]:
     """The published filter (δ̄ = 0.05) against the re-synthesized optimum.
 
     Both filters are evaluated on the same error system (13)–(15) of the
@@ -368,7 +365,7 @@ def compare_with_published(scenario: Scenario | None = None, solver: str | None 
     solver : str, optional
         Solver of the synthesis and of the robust bound (default: both).
     delta_points : int, optional
-    design : SynthesisResult, optional
+    design : DesignResult, optional
         A design at δ̄ = 0.05 to reuse (default: synthesized here).
 
     Returns
@@ -380,11 +377,11 @@ def compare_with_published(scenario: Scenario | None = None, solver: str | None 
         (shape (6, 3)), ``observer_residual``, ``filter_eigenvalues``,
         ``spectral_radius``; ``optimal`` also ``gamma``, ``lmi_gamma``;
         ``ratio`` = published worst norm / optimal certified γ;
-        ``excess_percent``; ``deltas``; ``design`` (the SynthesisResult).
+        ``excess_percent``; ``deltas``; ``design`` (the DesignResult).
     """
     scenario = _scenario(scenario)
-    if design is not None and not isinstance(design, SynthesisResult):
-        raise InputError(f"design must be a hinfnav SynthesisResult (from design_for_scenario); got {type(design).__name__}")
+    if design is not None and not isinstance(design, DesignResult):
+        raise InputError(f"design must be a hinfnav DesignResult (from design_for_scenario); got {type(design).__name__}")
     pub = published_filter()
     db = pub.delta_bar
     if design is None:
@@ -454,7 +451,7 @@ def _is_scenario_design(result):
 
 
 @scenario_keyword("result", "path", "scenario")
-def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLike[str], *,
+def save_design(result: DesignResult, path: str | os.PathLike[str], *,
                 scenario: Scenario | None = None) -> Path:
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
 
@@ -466,8 +463,8 @@ def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLi
     if scenario is None and own is not None and not _is_scenario_design(result):
         # a design of another system (not from design_for_scenario): saved with its own system
         return design_io.save_design(result, own, path, options={"form": result.form})
-    if not isinstance(result, SynthesisResult):
-        raise InputError(f"result must be a hinfnav SynthesisResult (from design_for_scenario); got {type(result).__name__}")
+    if not isinstance(result, DesignResult):
+        raise InputError(f"result must be a hinfnav DesignResult (from design_for_scenario); got {type(result).__name__}")
     scenario = _scenario(scenario)
     design_io.check_design_path(path)
     delta_bar = 0.0 if result.uncertainty_bound is None else float(result.uncertainty_bound)
@@ -478,7 +475,7 @@ def save_design(result: SynthesisResult | PolytopicResult, path: str | os.PathLi
 
 
 @scenario_keyword("path", "scenario")
-def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = None) -> SynthesisResult:
+def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = None) -> DesignResult:
     """Load a design file and check it was made for ``scenario`` (default the paper's).
 
     Raises
@@ -491,7 +488,7 @@ def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = Non
     if scenario is None and (d.get("extra") or {}).get("paper") != "sun2011":
         return result  # a design of another system: checked against its own fingerprint only
     scenario = _scenario(scenario)
-    if not isinstance(result, SynthesisResult):
+    if result.uncertainty != "norm-bounded":
         raise InputError(f"design file {path} was made for another system (a polytope of "
                          f"{getattr(system, 'n_vertices', '?')} vertices), not for the scenario: design again for it")
     delta_bar = 0.0 if result.uncertainty_bound is None else float(result.uncertainty_bound)

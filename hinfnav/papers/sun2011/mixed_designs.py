@@ -40,7 +40,7 @@ from .designs import delta_grid, delta_samples, design_for_scenario, design_repo
 from .scenario import Scenario
 
 if TYPE_CHECKING:
-    from ...design.mixed import MixedSynthesisResult
+    from ...design.mixed import DesignResult
 
 __all__ = ["mixed_design_for_scenario", "mixed_front_for_scenario", "mixed_design_report",
            "format_mixed_design_report", "analysis_gamma", "certify_front", "certified_knee"]
@@ -66,7 +66,7 @@ def _with_grid(result, delta_bar, delta_points):
 
 def mixed_design_for_scenario(scenario: Scenario | None = None, delta_bar: float | None = None,
                               gamma: float | None = None, *, delta_points: int = 21,
-                              **options: Any) -> MixedSynthesisResult:
+                              **options: Any) -> DesignResult:
     """Mixed H2/H∞ robust filter for a scenario's closed-loop model at δ̄.
 
     Minimizes the certified worst-case H2 norm ν of the error system (13)
@@ -89,7 +89,7 @@ def mixed_design_for_scenario(scenario: Scenario | None = None, delta_bar: float
 
     Returns
     -------
-    MixedSynthesisResult
+    DesignResult
         Its ``gamma`` the smaller of the synthesis and :func:`analysis_gamma` certificates.
     """
     scenario, delta_bar, system, samples = _setup(scenario, delta_bar, delta_points, options)
@@ -137,11 +137,11 @@ def certify_front(front, system):
 
 def _recertified(system, res):
     """``res`` with γ the smaller of its own and the analysis certificate; its own kept in
-    ``variables["gamma_synthesis"]`` (the level its returned LMI variables certify)."""
+    ``witness["gamma_synthesis"]`` (the level its returned LMI variables certify)."""
     g = analysis_gamma(system, res)
     if not g < res.gamma:
         return res
-    return dataclasses.replace(res, gamma=g, variables=dict(res.variables or {}, gamma_synthesis=float(res.gamma)))
+    return dataclasses.replace(res, gamma=g, witness=dict(res.witness or {}, gamma_synthesis=float(res.gamma)))
 
 
 def certified_knee(front):
@@ -179,7 +179,7 @@ def mixed_front_for_scenario(scenario=None, delta_bar=None, *, points=12, span=1
         The γ grid :func:`hinfnav.design.mixed.front_gammas`:
         ``γ*(1 + s)``, s log-spaced from ``first`` to ``span − 1``.
     delta_points : int, optional
-    hinf_result : SynthesisResult, optional
+    hinf_result : DesignResult, optional
         The H∞ optimum (Corollary 1) at this δ̄; designed here when None.
     progress : bool, optional
         Show a tqdm progress bar.
@@ -239,7 +239,7 @@ def mixed_design_report(scenario=None, delta_bar=None, gamma=None, solver=None, 
 
     Returns
     -------
-    tuple of (dict, MixedSynthesisResult)
+    tuple of (dict, DesignResult)
         The report has the fields of
         :func:`~hinfnav.papers.sun2011.designs.design_report` for the design
         (with a γ) or for the knee's design (without), plus ``objective``

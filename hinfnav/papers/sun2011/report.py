@@ -41,7 +41,7 @@ def simulate_report(filter="published", *, maneuver=True, delta=0.0, noise="gaus
         As in :func:`hinfnav.simulate`.
     scenario : Scenario, optional
     progress : bool
-    design : str or path-like or SynthesisResult, optional
+    design : str or path-like or DesignResult, optional
         A design file (``design --save``) or object to run instead of ``filter``;
         a file made for another system (another T …) is refused.
     verbatim : bool

@@ -20,7 +20,7 @@ from ...control.feedback import LinearFeedback
 from ...core.exceptions import InputError
 from ...core.linalg import discretize, spectral_radius
 from ...core.validation import as_choice, as_matrix, as_nonnegative, as_positive, as_real, as_vector
-from ...design.result import SynthesisResult
+from ...design.result import DesignResult
 from ...estimators.lti import LTIFilter
 from ...estimators.registry import Offers
 from ...sim.scenario import Scenario as BaseScenario
@@ -250,20 +250,23 @@ class Scenario(BaseScenario):
             return LTIFilter(A_F, B_F, C_F, system, meas, name=name, input_matrix=self.input_matrix_design(), K=self.K)
         return LTIFilter(A_F, B_F, C_F, system, meas, name=name)
 
-    def estimator_from_design(self, design: SynthesisResult, *, verbatim: bool = False,
+    def estimator_from_design(self, design: DesignResult, *, verbatim: bool = False,
                               name: str = "design") -> LTIFilter:
-        """An estimator from a :class:`~hinfnav.design.SynthesisResult` designed for this scenario.
+        """An estimator from a :class:`~hinfnav.design.DesignResult` designed for this scenario.
 
         Parameters
         ----------
-        design : SynthesisResult
+        design : DesignResult
         verbatim : bool
             Run (12) exactly as designed, assuming u = K x (what Table 1 does
             with maneuver); default: told the applied thrust.
         name : str
         """
-        if not isinstance(design, SynthesisResult):
-            raise InputError(f"design must be a hinfnav SynthesisResult; got {type(design).__name__}")
+        if not isinstance(design, DesignResult):
+            raise InputError(f"design must be a hinfnav DesignResult; got {type(design).__name__}")
+        if design.domain != "discrete":
+            raise InputError(f"design must be a discrete-time filter (this one is {design.domain} time): design it "
+                             "for the scenario's sampled model")
         dt = None if design.dt is True else design.dt
         return self.lti_filter(design.A_F, design.B_F, design.C_F, name=name, uses_input=not verbatim, design_dt=dt)
 

@@ -162,13 +162,13 @@ def simulation_comparison(scenario=None, design=None, runs=20, seed=0, *, observ
     ----------
     scenario : Scenario, optional
         Default: the paper's.
-    design : SynthesisResult, optional
+    design : DesignResult, optional
         The general (LMI (20)) design; default :func:`design_for_scenario`
         at ``delta_bar``.
     runs : int, optional
         Monte Carlo runs per case.
     seed : int, optional
-    observer : SynthesisResult or bool, optional
+    observer : DesignResult or bool, optional
         A third filter, in observer form (:func:`synthesize` with
         ``form="observer"``): a result to reuse, or True to design it at
         the δ̄ of ``design`` (``delta_bar`` if unset). None or False: two filters.

@@ -29,7 +29,7 @@ from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_seed
 from ...io.outputs import atomic_write_text
 from ...io.progress import bar_disabled
-from ...design.result import SynthesisResult
+from ...design.result import DesignResult
 from ...metrics.errors import axes_rms, rms_per_run
 from ...metrics.intervals import format_interval, mean_interval
 from ...sim.engine import Sink, batch_result, run_monte_carlo
@@ -208,10 +208,10 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     runs : int
         Monte Carlo runs per case (≥ 1; 100 or more for the interval).
     seed : int
-    designed : SynthesisResult, optional
+    designed : DesignResult, optional
         The filter from :func:`hinfnav.synthesize` (Corollary 1); designed here
         at ``delta_bar`` when None (about a second).
-    observer : SynthesisResult, optional
+    observer : DesignResult, optional
         The filter designed in observer form (an extension of the paper);
         designed here at ``delta_bar`` when None.
     progress : bool
@@ -234,8 +234,8 @@ def table1(scenario=None, *, runs=100, seed=0, designed=None, observer=None, pro
     as_seed("seed", seed)
     delta_bar = scenario.delta_bar if delta_bar is None else delta_bar  # checked by design_for_scenario
     for key, f in (("designed", designed), ("observer", observer)):
-        if f is not None and not isinstance(f, SynthesisResult):
-            raise InputError(f"{key} must be a hinfnav SynthesisResult (from design_for_scenario); got {type(f).__name__}")
+        if f is not None and not isinstance(f, DesignResult):
+            raise InputError(f"{key} must be a hinfnav DesignResult (from design_for_scenario); got {type(f).__name__}")
     if designed is None:
         designed = design_for_scenario(scenario, delta_bar=delta_bar)
     if observer is None:
