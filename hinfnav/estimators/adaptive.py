@@ -204,8 +204,8 @@ def strong_tracking_prior(PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64]
     return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
 
 
-def _check_per_run(estimator_rho_beta, runs):
-    for key, val in estimator_rho_beta:
+def _check_per_run(pairs, runs):
+    for key, val in pairs:
         if isinstance(val, np.ndarray) and val.size != runs:
             raise InputError(f"runs must equal the number of per-run values of {key} ({val.size}); got {runs}")
 

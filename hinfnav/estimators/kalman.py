@@ -33,7 +33,12 @@ variants override small hooks:
   unless the measurement's covariance depends on its reading (a converted
   range/angle measurement: ``J R Jᵀ`` at each reading);
 * the system it is built on (augmented and extended-state filters append
-  states to it).
+  states to it);
+* :attr:`~KalmanCore.moment_rule` — how the moments of the predicted reading are computed
+  (:mod:`hinfnav.estimators.moments`): linearised here (``observe``), the unscented transform for
+  :class:`~hinfnav.estimators.sigma_point.SigmaPointFilter`; and the strategies
+  :attr:`~KalmanCore.correction_rule` / :attr:`~KalmanCore.fading_rule` composed onto a built filter
+  (:mod:`hinfnav.estimators.strategies`) in place of ``correct_error`` / ``complete_prior``.
 
 With a linear measurement and one initial covariance for all runs the
 covariance and gain do not depend on the data: P is then carried once (2-D)
