@@ -112,3 +112,20 @@ def test_composed_filters_are_registered_run_on_numpy_and_refuse_what_they_canno
         build_estimator(SHI, "huber_ukf", covariance_form="sqrt")
     with pytest.raises(InputError, match="constant R"):
         compose(build_estimator(SHI, "ukf", measurement="converted"), fading="strong_tracking")
+
+
+def test_on_a_linear_model_the_sigma_point_compositions_are_the_ekf_ones():
+    # independent check: on Sun 2011's chaser (linear dynamics, Cartesian position) the unscented transform is
+    # exact, so the sigma-point moments are the Kalman ones and (M1) gives H̃ = H, R̃ = R: ST × UKF is the
+    # strong-tracking EKF and Huber × UKF the Huber filter, to rounding, while their fading and weights act
+    from hinfnav.papers.sun2011 import Scenario
+
+    sun = Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0))
+    tr = simulate_truth(sun.truth_model(maneuver=True), runs=2, seed=7, noise="mixture")
+    for composed, named, acts in [("stukf", "stekf", lambda h: h.diagnostics["fading"].max() > 1.5),
+                                  ("huber_ukf", "hbf", lambda h: h.diagnostics["weights"].min() < 0.9)]:
+        a = build_estimator(sun, composed).estimate(tr.y, tr.u, sun.xhat0, backend="numpy", diagnostics=True)
+        b = build_estimator(sun, named).estimate(tr.y, tr.u, sun.xhat0, backend="numpy", diagnostics=True)
+        assert acts(b), named  # the idea is active on this record
+        np.testing.assert_allclose(a.xhat, b.xhat, rtol=0, atol=1e-10 * np.abs(b.xhat).max())
+        np.testing.assert_allclose(a.P, b.P, rtol=0, atol=1e-9 * np.abs(b.P).max())
