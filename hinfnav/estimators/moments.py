@@ -41,16 +41,10 @@ __all__ = ["LINEARISED", "LinearisedRule", "Moments", "statistical_linearisation
 class Moments(NamedTuple):
     """The moments of one predicted reading, all runs at once.
 
-    Attributes
-    ----------
-    yhat : ndarray, shape (runs, m)
-        The predicted reading ȳ.
-    H : ndarray, shape (m, n) or (runs, m, n), or None
-        The Jacobian at the prior (linearised rule); None for a sigma-point rule.
-    dX : ndarray, shape (runs, N, n), or None
-        Deviations of the state's sigma points from the prior (sigma-point rule).
-    dY : ndarray, shape (runs, N, m), or None
-        Deviations of their predicted readings from ȳ (sigma-point rule).
+    Fields: ``yhat`` (runs, m), the predicted reading ȳ; ``H`` (m, n) or (runs, m, n), the Jacobian at the
+    prior (linearised rule; None for a sigma-point rule); ``dX`` (runs, N, n), the deviations of the state's
+    sigma points from the prior, and ``dY`` (runs, N, m), those of their predicted readings from ȳ
+    (sigma-point rule; None for the linearised one).
     """
 
     yhat: NDArray[np.float64]
