@@ -61,7 +61,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import HinfnavError, InputError, ModelFunctionError
 from ..core.linalg import as_covariance, inv_spd
@@ -331,13 +331,41 @@ class SigmaPointFilter(KalmanCore):
         self.output = as_choice("output", output, OUTPUTS)
 
     # the rule's parameters, read by the compiled kernel, the square-root form and the smoothers
-    rule = property(lambda self: self.moment_rule.rule, doc="The sigma-point rule, unscented or cubature.")
-    alpha = property(lambda self: self.moment_rule.alpha, doc="α of (U2).")
-    beta = property(lambda self: self.moment_rule.beta, doc="β of (U2).")
-    kappa = property(lambda self: self.moment_rule.kappa, doc="κ of (U2).")
-    scale = property(lambda self: self.moment_rule.scale, doc="n + λ of (U1) (n for the cubature rule).")
-    Wm = property(lambda self: self.moment_rule.Wm, doc="Mean weights W^m (U2).")
-    Wc = property(lambda self: self.moment_rule.Wc, doc="Covariance weights W^c (U2).")
+
+    @property
+    def rule(self) -> str:
+        """The sigma-point rule, "unscented" or "cubature"."""
+        return self.moment_rule.rule
+
+    @property
+    def alpha(self) -> float:
+        """α of (U2)."""
+        return self.moment_rule.alpha
+
+    @property
+    def beta(self) -> float:
+        """β of (U2)."""
+        return self.moment_rule.beta
+
+    @property
+    def kappa(self) -> float:
+        """κ of (U2)."""
+        return self.moment_rule.kappa
+
+    @property
+    def scale(self) -> float:
+        """n + λ of (U1) (n for the cubature rule)."""
+        return self.moment_rule.scale
+
+    @property
+    def Wm(self) -> NDArray[np.float64]:
+        """Mean weights W^m of (U2)."""
+        return self.moment_rule.Wm
+
+    @property
+    def Wc(self) -> NDArray[np.float64]:
+        """Covariance weights W^c of (U2)."""
+        return self.moment_rule.Wc
 
     @property
     def shares_covariance(self) -> bool:
@@ -358,16 +386,16 @@ class SigmaPointFilter(KalmanCore):
 
     # -- model hooks of the core ---------------------------------------------------------
 
-    def inject(self, x, dx):
+    def inject(self, x: NDArray[np.float64], dx: NDArray[np.float64]) -> NDArray[np.float64]:
         """``x ⊞ δx``: x + δx, or the system's injection (``q ← δq(δθ) ⊗ q``, the rest added)."""
         return x + dx if not self.error_coordinates else self.system.inject(np.broadcast_to(x, dx.shape[:-1] + x.shape[-1:]), dx)
 
-    def initial_internal(self, xhat0):
+    def initial_internal(self, xhat0: NDArray[np.float64]) -> NDArray[np.float64]:
         """The prior estimate, normalised by the system's injection of a zero correction (a unit quaternion)."""
         x = as_vector("xhat0", xhat0, self.n_state)
         return self.inject(x[None, :], np.zeros((1, self.n_cov)))[0] if self.error_coordinates else x
 
-    def difference(self, x, ref):
+    def difference(self, x: NDArray[np.float64], ref: NDArray[np.float64]) -> NDArray[np.float64]:
         """``x ⊟ ref``, the inverse of :meth:`inject`: x − ref, or (U6) for a quaternion-first state."""
         if not self.error_coordinates:
             return x - ref
@@ -375,7 +403,7 @@ class SigmaPointFilter(KalmanCore):
         dq = quat_multiply(x[..., :4], quat_conjugate(ref[..., :4]))
         return np.concatenate([rotvec_from_quat(dq), x[..., 4:] - ref[..., 4:]], axis=-1)
 
-    def propagate_points(self, X, u, t):
+    def propagate_points(self, X: NDArray[np.float64], u: NDArray[np.float64] | None, t: float) -> NDArray[np.float64]:
         """The dynamics at points X (a batch of states): ``f(X, u, t)``, or the system's ``predict_mean``."""
         if self.error_coordinates:
             return np.asarray(self.system.predict_mean(X, u))
