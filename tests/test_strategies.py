@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from hinfnav.core.exceptions import InputError
-from hinfnav.estimators import (ExtendedKalmanFilter, HuberFilter, SigmaPointFilter, StrongTrackingEKF,
-                                build_estimator, registered_estimators)
+from hinfnav.estimators import (CorrentropyFilter, ExtendedKalmanFilter, HuberFilter, SigmaPointFilter,
+                                StrongTrackingEKF, build_estimator, registered_estimators)
 from hinfnav.estimators.compiled import why_numpy
 from hinfnav.estimators.huber_filter import HuberStrategy
 from hinfnav.estimators.moments import statistical_linearisation
@@ -47,6 +47,15 @@ def test_huber_ukf_with_infinite_threshold_is_the_ukf(truth):
     np.testing.assert_allclose(hub.diagnostics["innovation_covariance"], S, rtol=1e-9, atol=1e-12 * np.abs(S).max())
 
 
+def test_correntropy_ukf_with_infinite_bandwidth_is_the_ukf(truth):
+    # closed form: G_σ(e) = exp(−e²/2σ²) is 1 in double precision for σ = 1e12 and every residual here
+    ukf = _run(build_estimator(SHI, "ukf"), truth)
+    mc = _run(build_estimator(SHI, "ukf", correction={"name": "correntropy", "sigma": 1e12}), truth)
+    np.testing.assert_array_equal(mc.diagnostics["weights"], 1.0)
+    np.testing.assert_allclose(mc.xhat, ukf.xhat, rtol=0, atol=1e-9 * np.abs(ukf.xhat).max())
+    np.testing.assert_allclose(mc.P, ukf.P, rtol=0, atol=1e-9 * np.abs(ukf.P).max())
+
+
 def test_strong_tracking_ukf_with_unit_fading_is_the_ukf(truth):
     ukf = _run(build_estimator(SHI, "ukf"), truth)
     est = build_estimator(SHI, "stukf", fading={"name": "strong_tracking", "beta": 1e15})  # N < 0 ⇒ λ = 1 (S3)
@@ -70,7 +79,9 @@ def test_on_the_linearised_rule_the_strategies_are_the_named_classes(truth):
     ekf = ExtendedKalmanFilter(*_direct_model(), P0=SHI.P0)
     named_h = HuberFilter.from_ekf(ekf, gamma=1.5)
     named_s = StrongTrackingEKF(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R, rho=0.9)
+    named_c = CorrentropyFilter.from_ekf(ekf, sigma=3.0)
     for named, composed in [(named_h, compose(ekf, correction=HuberStrategy(gamma=1.5))),
+                            (named_c, compose(ekf, correction={"name": "correntropy", "sigma": 3.0})),
                             (named_s, compose(ekf, fading={"name": "strong_tracking", "rho": 0.9}))]:
         a, b = _run(named, truth), _run(composed, truth)
         np.testing.assert_array_equal(a.xhat, b.xhat)  # the same functions on the same arrays: bitwise

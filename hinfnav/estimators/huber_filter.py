@@ -98,8 +98,9 @@ class HuberStrategy:
         """Check that ``estimator`` can take this correction (none needed: R may depend on the reading)."""
 
     def correct_error(self, estimator: Any, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
-                      innovation: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
-        """``(δx, P⁺, diagnostics)`` of :func:`huber_correct_error` (P per run)."""
+                      innovation: NDArray[np.float64], x: NDArray[np.float64] | None = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+        """``(δx, P⁺, diagnostics)`` of :func:`huber_correct_error` (P per run; the prior estimate x is not used)."""
         LRi = whitening(R) if R is estimator.R else None  # the constant R whitened as HuberCorrection does
         return huber_correct_error(P, H, R, innovation, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
                                    LRi=LRi)

@@ -211,7 +211,7 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
         """
         R = self.R if R is None else R
         if self.correction_rule is not None:  # a composed correction strategy
-            dx, P_post, diag = self.correction_rule.correct_error(self, P, H, R, innovation)
+            dx, P_post, diag = self.correction_rule.correct_error(self, P, H, R, innovation, x)
         else:
             dx, P_post, diag = self.correct_error(P, H, R, innovation)
         return self.inject(x, dx), P_post, diag

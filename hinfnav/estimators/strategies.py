@@ -6,7 +6,8 @@ A filter of the Kalman core (:class:`~hinfnav.estimators.kalman.KalmanCore`) is 
   filters) or sigma-point (:class:`~hinfnav.estimators.sigma_point.SigmaPointFilter`: the unscented or
   cubature transform), which gives the moments of the predicted reading and the prediction;
 * a **correction** strategy acting on those moments: the Kalman update (J1)-(J2) unless one is composed,
-  ``"huber"`` (:class:`~hinfnav.estimators.huber_filter.HuberStrategy`);
+  ``"huber"`` (:class:`~hinfnav.estimators.huber_filter.HuberStrategy`) or ``"correntropy"``
+  (:class:`~hinfnav.estimators.correntropy.CorrentropyStrategy`, Chen et al. 2017);
 * a **fading** strategy completing the prior at the next reading: none, or ``"strong_tracking"``
   (:class:`~hinfnav.estimators.adaptive.StrongTrackingStrategy`).
 
@@ -22,9 +23,14 @@ A strategy is given by its name (its defaults), by the dict ``{"name": ..., **pa
 cell's JSON), or as an instance (``HuberStrategy(gamma=2.0)``). A composed filter runs on the NumPy path:
 :func:`~hinfnav.estimators.compiled.why_numpy` says so (no kernel knows the combination).
 
-Not (yet) strategies: the Student-t and noise-adaptive variational corrections and the maximum-correntropy
-correction (:mod:`hinfnav.estimators.variational`, :mod:`hinfnav.estimators.correntropy`) carry state between
-readings through their own ``correct`` and stay classes on the linearised rule; rate-adapted noise
+A correction strategy is an object with ``name``, ``bind(estimator)`` (checks) and
+``correct_error(estimator, P, H, R, innovation, x) -> (δx, P⁺, diagnostics)``; a fading strategy has ``name``,
+``bind``, ``check_runs(runs)``, ``initial_diagnostics(estimator, runs)`` and ``complete_prior(estimator, ΦPΦᵀ,
+Q_d, state, innovation, H, mask)`` (the core's hooks, with the filter passed in).
+
+Not (yet) strategies: the Student-t and noise-adaptive variational corrections
+(:mod:`hinfnav.estimators.variational`) carry their noise estimates between readings through their own
+``correct`` and stay classes on the linearised rule; rate-adapted noise
 (:class:`~hinfnav.estimators.adaptive.RateAdaptive`) keeps its mixin.
 """
 
@@ -36,13 +42,14 @@ from typing import Any
 from ..core.exceptions import InputError
 from .adaptive import StrongTrackingStrategy
 from .correction import KalmanCorrection
+from .correntropy import CorrentropyStrategy
 from .huber_filter import HuberStrategy
 from .kalman import KalmanCore
 
 __all__ = ["CORRECTIONS", "FADINGS", "as_strategy", "compose"]
 
 #: Correction strategies by name.
-CORRECTIONS = {"huber": HuberStrategy}
+CORRECTIONS = {"huber": HuberStrategy, "correntropy": CorrentropyStrategy}
 #: Prior-fading strategies by name.
 FADINGS = {"strong_tracking": StrongTrackingStrategy}
 
