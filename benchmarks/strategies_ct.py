@@ -5,7 +5,7 @@ range/bearing sensor at the origin (:class:`hinfnav.systems.RangeBearing`); the 
 or heavy-tailed with the SAME covariance R the filters are given (a unit-variance shape times D: the
 ε-contaminated Gaussian (1−ε) N + ε N(0, r²) with ε = 0.1, r = 10, and Student-t with 5 degrees of freedom).
 Every filter has the model's true Q and R and the package defaults (Huber γ = 1.345; strong tracking
-ρ = 0.95, β = 1): nothing is tuned. Reports the position RMSE (m) pooled over steps 20…n and over all runs, over the runs not lost (position error
+ρ = 0.95, β = 1; maximum correntropy σ = 2): nothing is tuned. Reports the position RMSE (m) pooled over steps 20…n and over all runs, over the runs not lost (position error
 below 1 km throughout), and the number of runs lost.
 
     python benchmarks/strategies_ct.py [--runs 100] [--steps 200] [--seed 0]
@@ -16,7 +16,7 @@ import argparse
 import numpy as np
 
 from hinfnav.core.exceptions import HinfnavError
-from hinfnav.estimators import ExtendedKalmanFilter, HuberFilter, SigmaPointFilter, StrongTrackingEKF
+from hinfnav.estimators import CorrentropyFilter, ExtendedKalmanFilter, HuberFilter, SigmaPointFilter, StrongTrackingEKF
 from hinfnav.estimators.strategies import compose
 from hinfnav.noise import GaussianNoise, MixtureNoise, StudentTNoise
 from hinfnav.systems import ConstantTurn, RangeBearing
@@ -48,8 +48,10 @@ def filters(system, meas):
     ekf = ExtendedKalmanFilter(system, meas, P0=P0)
     ukf = SigmaPointFilter(system, meas, P0=P0)
     return {"ekf": ekf, "hbf (Huber x EKF)": HuberFilter.from_ekf(ekf),
-            "stekf (ST x EKF)": StrongTrackingEKF(system, meas, P0=P0), "ukf": ukf,
-            "huber_ukf": compose(ukf, correction="huber"), "stukf": compose(ukf, fading="strong_tracking")}
+            "stekf (ST x EKF)": StrongTrackingEKF(system, meas, P0=P0), "mckf (MCC x EKF)": CorrentropyFilter.from_ekf(ekf),
+            "ukf": ukf,
+            "huber_ukf": compose(ukf, correction="huber"), "stukf": compose(ukf, fading="strong_tracking"),
+            "mcc_ukf (MCC x UKF)": compose(ukf, correction="correntropy", name="mcc_ukf")}
 
 
 #: A run whose position error exceeds this at any step after the first 20 is counted as lost, m.

@@ -40,7 +40,7 @@ on, a saturated-measurement filter the update when a channel is clipped.
 of :class:`~hinfnav.estimators.kalman.KalmanCore` is its *moment rule* (:mod:`hinfnav.estimators.moments`:
 linearised, or the sigma-point :class:`~hinfnav.estimators.sigma_point.SigmaPointRule`), which gives the
 prediction and the moments of the predicted reading (ȳ, S, P_xy), plus *strategies* that act on those moments
-whatever the rule: a correction (``"huber"``) and a prior fading (``"strong_tracking"``). The one scheme:
+whatever the rule: a correction (``"huber"``, ``"correntropy"``) and a prior fading (``"strong_tracking"``). The one scheme:
 ``build_estimator(scenario, name, correction=..., fading=...)`` composes strategies onto the registered filter
 ``name``, and :func:`~hinfnav.estimators.registry.register_composition` names a combination
 (``huber_ukf`` = ``ukf`` + ``correction="huber"``; ``stukf`` = ``ukf`` + ``fading="strong_tracking"``). A
