@@ -60,19 +60,19 @@ LOST_M = 1000.0
 
 def rmse(est, xs, ys, first):
     """``(RMSE over all runs, RMSE over the runs not lost, runs lost)``: pooled position RMSE, m (a run that
-    raises FilterDivergedError counts as lost)."""
+    stops with an error — FilterDivergedError, a singular matrix — counts as lost)."""
     runs = xs.shape[0]
     u = np.zeros(ys.shape[:2] + (0,))
     try:
         xhat = est.estimate(ys, u, X0, keep_covariance=False).xhat
         ok = np.ones(runs, dtype=bool)
-    except HinfnavError:  # some run diverged: run one by one
+    except (HinfnavError, np.linalg.LinAlgError):  # some run diverged or hit a singular matrix: run one by one
         xhat, ok = np.full(xs.shape, np.nan), np.zeros(runs, dtype=bool)
         for r in range(runs):
             try:
                 xhat[r] = est.estimate(ys[r:r + 1], u[r:r + 1], X0, keep_covariance=False).xhat[0]
                 ok[r] = np.isfinite(xhat[r]).all()
-            except HinfnavError:
+            except (HinfnavError, np.linalg.LinAlgError):
                 pass
     err2 = np.sum((xhat - xs)[:, first:, :2] ** 2, axis=-1)
     kept = ok & (np.nanmax(err2, axis=1) < LOST_M**2)
