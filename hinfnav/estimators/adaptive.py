@@ -55,6 +55,8 @@ if TYPE_CHECKING:
 __all__ = [
     "RateAdaptive",
     "StrongTracking",
+    "StrongTrackingStrategy",
+    "strong_tracking_prior",
     "fade",
     "fading_factors",
     "innovation_moment",
@@ -172,6 +174,88 @@ def _check_beta(name, value):
     return value
 
 
+def strong_tracking_prior(PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], state: FilterState,
+                          innovation: NDArray[np.float64], H: NDArray[np.float64], mask: NDArray[np.bool_] | None, *,
+                          R: NDArray[np.float64], rho: Any, beta: Any, a: NDArray[np.float64]
+                          ) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:
+    """(S1)-(S4) at a reading: ``(P(k+1|k), diagnostics, extra)`` (the ``complete_prior`` hook's return).
+
+    ``innovation`` and H are zero on the channels ``~mask`` a reading lacks (mask None: none); the moment V₀
+    is read from and returned in ``state.extra``. With missing channels the moment and N use the channels
+    the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only).
+    """
+    V0_old = state.extra.get("V0")
+    V0 = innovation_moment(V0_old, innovation, rho)
+    keep = {}
+    if mask is not None or "V0_started" in state.extra:  # some run has skipped a whole reading
+        runs = innovation.shape[0]
+        gone = np.zeros(runs, dtype=bool) if mask is None else ~mask.any(axis=1)
+        started = state.extra.get("V0_started", np.full(runs, V0_old is not None))
+        fresh = innovation_moment(None, innovation, rho)
+        if V0_old is not None:  # (S1) from γγᵀ in the runs without a moment yet; unchanged in the skipped ones
+            V0 = np.where(gone[:, None, None], V0_old, np.where(started[:, None, None], V0, fresh))
+        keep = {"V0_started": started | ~gone}
+    if mask is not None:
+        R = np.where(mask[:, :, None] & mask[:, None, :], R, 0.0)
+    lam, c = fading_factors(V0, H, PhiPPhiT, Qd, R, beta=beta, a=a)
+    if mask is not None:
+        lam = np.where(gone[:, None], 1.0, lam)
+    P = fade(PhiPPhiT, lam) + Qd
+    return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
+
+
+def _check_per_run(pairs, runs):
+    for key, val in pairs:
+        if isinstance(val, np.ndarray) and val.size != runs:
+            raise InputError(f"runs must equal the number of per-run values of {key} ({val.size}); got {runs}")
+
+
+class StrongTrackingStrategy:
+    """Strong tracking (S1)–(S4) as a prior-fading *strategy*: composed onto any filter of the Kalman core
+    (:func:`~hinfnav.estimators.strategies.compose`; ``fading="strong_tracking"``), whatever its moment rule.
+
+    On the linearised rule it is :class:`StrongTracking`'s fading, bitwise; on the sigma-point rule ``Φ P Φᵀ``
+    is the propagated points' covariance ``Σ W^c dX dXᵀ`` and H the statistical linearisation (M1) of
+    :mod:`hinfnav.estimators.moments` at the uncompleted prior (the sigma points are then redrawn from the
+    faded prior). Parameters ``rho``, ``beta``, ``a`` as :class:`StrongTracking`'s; the filter needs a
+    constant R. Diagnostics ``fading``, ``fading_c``.
+    """
+
+    name = "strong_tracking"
+
+    def __init__(self, rho: float = 0.95, beta: float = 1.0, a: ArrayLike | None = None) -> None:
+        self.rho = per_run_parameter("rho", rho, _check_rho)
+        self.beta = per_run_parameter("beta", beta, _check_beta)
+        self.a = None if a is None else np.asarray(a, dtype=float)
+
+    def __repr__(self) -> str:
+        return f"StrongTrackingStrategy(rho={self.rho}, beta={self.beta}, a={self.a})"
+
+    def bind(self, estimator: Any) -> None:
+        """Check that ``estimator`` can take this fading: a constant R, and ``a`` of its covariance's size."""
+        if getattr(estimator, "R", None) is None:
+            raise InputError("strong tracking needs a constant R (N of (S2) subtracts β R); give R to the filter")
+        n = estimator.n_cov
+        if self.a is not None and (self.a.shape != (n,) or not np.all(np.isfinite(self.a)) or np.any(self.a < 1)):
+            raise InputError(f"a (prior weights of the fading factors) must be {n} numbers >= 1; got {self.a}")
+
+    def check_runs(self, runs: int) -> None:
+        """A per-run ρ or β must have one value per run."""
+        _check_per_run((("rho", self.rho), ("beta", self.beta)), runs)
+
+    def complete_prior(self, estimator: Any, PhiPPhiT: NDArray[np.float64], Qd: NDArray[np.float64], state: FilterState,
+                       innovation: NDArray[np.float64], H: NDArray[np.float64],
+                       mask: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:
+        """(S1)-(S4) by :func:`strong_tracking_prior` with the filter's R."""
+        a = np.ones(estimator.n_cov) if self.a is None else self.a
+        return strong_tracking_prior(PhiPPhiT, Qd, state, innovation, H, mask, R=estimator.R, rho=self.rho,
+                                     beta=self.beta, a=a)
+
+    def initial_diagnostics(self, estimator: Any, runs: int) -> dict[str, Any]:
+        """``fading`` 1 and ``fading_c`` NaN before the first completed prior."""
+        return {"fading": np.ones((runs, estimator.n_cov)), "fading_c": np.full(runs, np.nan)}
+
+
 class StrongTracking:
     """Mixin: strong tracking by multiple fading factors (S1)–(S4).
 
@@ -224,30 +308,11 @@ class StrongTracking:
                        mask: NDArray[np.bool_] | None = None) -> tuple[NDArray[np.float64], dict[str, Any], dict[str, Any]]:
         """(S1)-(S4). With missing channels (``~mask``; innovation and H zero there) the moment and N use the
         channels the reading has; a run without any channel keeps V₀ and takes λ = 1 (a prediction only)."""
-        V0_old = state.extra.get("V0")
-        V0 = innovation_moment(V0_old, innovation, self.rho)
-        R, keep = self.R, {}
-        if mask is not None or "V0_started" in state.extra:  # some run has skipped a whole reading
-            runs = innovation.shape[0]
-            gone = np.zeros(runs, dtype=bool) if mask is None else ~mask.any(axis=1)
-            started = state.extra.get("V0_started", np.full(runs, V0_old is not None))
-            fresh = innovation_moment(None, innovation, self.rho)
-            if V0_old is not None:  # (S1) from γγᵀ in the runs without a moment yet; unchanged in the skipped ones
-                V0 = np.where(gone[:, None, None], V0_old, np.where(started[:, None, None], V0, fresh))
-            keep = {"V0_started": started | ~gone}
-        if mask is not None:
-            R = np.where(mask[:, :, None] & mask[:, None, :], R, 0.0)
-        lam, c = fading_factors(V0, H, PhiPPhiT, Qd, R, beta=self.beta, a=self.a)
-        if mask is not None:
-            lam = np.where(gone[:, None], 1.0, lam)
-        P = fade(PhiPPhiT, lam) + Qd
-        return P, {"fading": lam, "fading_c": np.broadcast_to(c, (innovation.shape[0],))}, dict(keep, V0=V0)
+        return strong_tracking_prior(PhiPPhiT, Qd, state, innovation, H, mask, R=self.R, rho=self.rho,
+                                     beta=self.beta, a=self.a)
 
     def _start(self, xhat0, P0, runs):
-        for key in ("rho", "beta"):
-            val = getattr(self, key)
-            if isinstance(val, np.ndarray) and val.size != runs:
-                raise InputError(f"runs must equal the number of per-run values of {key} ({val.size}); got {runs}")
+        _check_per_run((("rho", self.rho), ("beta", self.beta)), runs)
         return super()._start(xhat0, P0, runs)
 
     def initial_diagnostics(self, runs: int) -> dict[str, Any]:

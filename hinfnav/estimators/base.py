@@ -35,6 +35,18 @@ y and u, and name the parameter and the step in an
 Variants override one hook: the Huber filter the correction, a strong-tracking
 filter the covariance prediction, an augmented filter the system it is built
 on, a saturated-measurement filter the update when a channel is clipped.
+
+**Filters of the Kalman core are composed, not subclassed** (:mod:`hinfnav.estimators.strategies`): a filter
+of :class:`~hinfnav.estimators.kalman.KalmanCore` is its *moment rule* (:mod:`hinfnav.estimators.moments`:
+linearised, or the sigma-point :class:`~hinfnav.estimators.sigma_point.SigmaPointRule`), which gives the
+prediction and the moments of the predicted reading (ȳ, S, P_xy), plus *strategies* that act on those moments
+whatever the rule: a correction (``"huber"``, ``"correntropy"``) and a prior fading (``"strong_tracking"``). The one scheme:
+``build_estimator(scenario, name, correction=..., fading=...)`` composes strategies onto the registered filter
+``name``, and :func:`~hinfnav.estimators.registry.register_composition` names a combination
+(``huber_ukf`` = ``ukf`` + ``correction="huber"``; ``stukf`` = ``ukf`` + ``fading="strong_tracking"``). A
+composed filter keeps its class (and its checks), runs on the NumPy path, and reports its strategies in
+``est.strategies``. The named classes of the linearised rule (``HuberFilter``, ``StrongTrackingEKF`` …) remain
+as configurations with compiled kernels; on the EKF a composition gives their numbers bitwise.
 """
 
 from __future__ import annotations

@@ -146,6 +146,10 @@ def _linear_measurement(est):
 
 def kernel_status(est: Any) -> str | None:
     """Why ``est`` has no compiled kernel, or None when it has one (diagnostics aside)."""
+    composed = getattr(est, "strategies", ())
+    if composed:  # a filter composed with strategies (hinfnav.estimators.strategies): no kernel knows the combination
+        return (f"its class {type(est).__name__} is composed with the {' and '.join(composed)} strategy "
+                "(no compiled kernel for this combination)")
     kind = _kind(est)
     if kind is None:
         inherited = getattr(type(est), "compiled_kernel", None)

@@ -49,10 +49,79 @@ from .variational import DataDependentCorrection, _from_ekf, _prior_per_run, _sw
 if TYPE_CHECKING:
     from .base import FilterState
 
-__all__ = ["CorrentropyCorrection", "CorrentropyFilter", "WEIGHT_FLOOR"]
+__all__ = ["CorrentropyCorrection", "CorrentropyFilter", "CorrentropyStrategy", "WEIGHT_FLOOR", "correntropy_correct_error"]
 
 #: Smallest kernel weight G_σ(e) used (see the module docstring).
 WEIGHT_FLOOR = 1e-100
+
+
+def correntropy_correct_error(x: NDArray[np.float64], P: NDArray[np.float64], H: NDArray[np.float64],
+                              R: NDArray[np.float64], innovation: NDArray[np.float64], *, sigma: float, tol: float,
+                              max_iter: int) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+    """The kernel-weighted fixed point of the module docstring: ``(δx, P⁺, diagnostics)`` (P per run).
+
+    ``x`` (runs, n_x) the prior estimate (the relative stopping rule's reference when it has P's size),
+    P (n, n) or (runs, n, n), H (m, n) or (runs, m, n), R (m, m) or (runs, m, m), innovation (runs, m).
+    """
+    runs, P, n, x_ref = _prior_per_run(x, P, innovation)
+    Bp = np.linalg.cholesky(P)
+    Br = np.linalg.cholesky(R)
+    HT = _swap(H)
+    two_s2 = 2.0 * sigma**2
+    dx = np.zeros((runs, n))
+    K_fin = np.zeros((runs, n, innovation.shape[1]))
+    weights = np.ones((runs, n + innovation.shape[1]))
+    active = np.ones(runs, dtype=bool)
+    iters = np.zeros(runs, dtype=int)
+    for _ in range(max_iter):
+        ex = np.linalg.solve(Bp, -dx[..., None])[..., 0]
+        ey = np.linalg.solve(Br, (innovation - (H @ dx[..., None])[..., 0])[..., None])[..., 0]
+        cx = np.maximum(np.exp(-ex**2 / two_s2), WEIGHT_FLOOR)
+        cy = np.maximum(np.exp(-ey**2 / two_s2), WEIGHT_FLOOR)
+        Pt = (Bp / cx[:, None, :]) @ _swap(Bp)
+        Rt = (Br / cy[:, None, :]) @ _swap(Br)
+        PHT = Pt @ HT
+        K = _swap(np.linalg.solve(H @ PHT + Rt, _swap(PHT)))
+        dx_new = (K @ innovation[..., None])[..., 0]
+        change = relative_change(dx_new, dx, None if x_ref is None else x_ref + dx - dx_new)
+        dx = np.where(active[:, None], dx_new, dx)
+        K_fin = np.where(active[:, None, None], K, K_fin)
+        weights = np.where(active[:, None], np.concatenate([cx, cy], axis=1), weights)
+        iters = iters + active
+        active = active & ~(change <= tol)
+        if not active.any():
+            break
+    P_post = joseph_covariance(P, K_fin, H, R, symmetrize=False)
+    return dx, P_post, {"weights": weights, "iterations": iters, "converged": ~active,
+                        "innovation_covariance": H @ P @ HT + R}
+
+
+class CorrentropyStrategy:
+    """The maximum-correntropy correction as a correction *strategy* (``correction="correntropy"``): composed
+    onto any filter of the Kalman core (:func:`~hinfnav.estimators.strategies.compose`), on the sigma-point rule
+    through the statistical linearisation (M1) of :mod:`hinfnav.estimators.moments`. Parameters ``sigma``,
+    ``tol``, ``max_iter`` as :class:`CorrentropyFilter`'s; on the EKF it gives that filter's numbers bitwise.
+    """
+
+    name = "correntropy"
+
+    def __init__(self, sigma: float = 2.0, tol: float = 1e-6, max_iter: int = 100) -> None:
+        self.sigma = as_positive("sigma", sigma)
+        self.tol = as_nonnegative("tol", tol)
+        self.max_iter = as_int_at_least("max_iter", max_iter, 1)
+
+    def __repr__(self) -> str:
+        return f"CorrentropyStrategy(sigma={self.sigma}, tol={self.tol}, max_iter={self.max_iter})"
+
+    def bind(self, estimator: Any) -> None:
+        """Nothing to check (R may depend on the reading)."""
+
+    def correct_error(self, estimator: Any, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
+                      innovation: NDArray[np.float64], x: NDArray[np.float64]
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+        """``(δx, P⁺, diagnostics)`` of :func:`correntropy_correct_error`."""
+        return correntropy_correct_error(x, P, H, R, innovation, sigma=self.sigma, tol=self.tol,
+                                         max_iter=self.max_iter)
 
 
 class CorrentropyCorrection(DataDependentCorrection):
@@ -72,38 +141,9 @@ class CorrentropyCorrection(DataDependentCorrection):
                 innovation: NDArray[np.float64], state: FilterState,
                 R: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """The kernel-weighted fixed point of the module docstring; returns ``(x⁺, P⁺, diagnostics)`` (P per run)."""
-        R = self.R if R is None else R
-        runs, P, n, x_ref = _prior_per_run(x, P, innovation)
-        Bp = np.linalg.cholesky(P)
-        Br = np.linalg.cholesky(R)
-        HT = _swap(H)
-        two_s2 = 2.0 * self.sigma**2
-        dx = np.zeros((runs, n))
-        K_fin = np.zeros((runs, n, innovation.shape[1]))
-        weights = np.ones((runs, n + innovation.shape[1]))
-        active = np.ones(runs, dtype=bool)
-        iters = np.zeros(runs, dtype=int)
-        for _ in range(self.max_iter):
-            ex = np.linalg.solve(Bp, -dx[..., None])[..., 0]
-            ey = np.linalg.solve(Br, (innovation - (H @ dx[..., None])[..., 0])[..., None])[..., 0]
-            cx = np.maximum(np.exp(-ex**2 / two_s2), WEIGHT_FLOOR)
-            cy = np.maximum(np.exp(-ey**2 / two_s2), WEIGHT_FLOOR)
-            Pt = (Bp / cx[:, None, :]) @ _swap(Bp)
-            Rt = (Br / cy[:, None, :]) @ _swap(Br)
-            PHT = Pt @ HT
-            K = _swap(np.linalg.solve(H @ PHT + Rt, _swap(PHT)))
-            dx_new = (K @ innovation[..., None])[..., 0]
-            change = relative_change(dx_new, dx, None if x_ref is None else x_ref + dx - dx_new)
-            dx = np.where(active[:, None], dx_new, dx)
-            K_fin = np.where(active[:, None, None], K, K_fin)
-            weights = np.where(active[:, None], np.concatenate([cx, cy], axis=1), weights)
-            iters = iters + active
-            active = active & ~(change <= self.tol)
-            if not active.any():
-                break
-        P_post = joseph_covariance(P, K_fin, H, R, symmetrize=False)
-        return self.inject(x, dx), P_post, {"weights": weights, "iterations": iters, "converged": ~active,
-                                            "innovation_covariance": H @ P @ HT + R}
+        dx, P_post, diag = correntropy_correct_error(x, P, H, self.R if R is None else R, innovation, sigma=self.sigma,
+                                                     tol=self.tol, max_iter=self.max_iter)
+        return self.inject(x, dx), P_post, diag
 
 
 class CorrentropyFilter(CorrentropyCorrection, ExtendedKalmanFilter):

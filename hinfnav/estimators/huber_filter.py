@@ -44,7 +44,66 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["HuberCorrection", "HuberFilter", "HuberStrongTrackingEKF"]
+__all__ = ["HuberCorrection", "HuberFilter", "HuberStrategy", "HuberStrongTrackingEKF", "huber_correct_error"]
+
+
+def huber_correct_error(P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
+                        innovation: NDArray[np.float64], *, gamma: float, tol: float, max_iter: int,
+                        LRi: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+    """Huber M-estimation of the correction δx (the module docstring's regression); ``(δx, P⁺, diagnostics)``.
+
+    P (n, n) or (runs, n, n) (made per run), H (m, n) or (runs, m, n), R (m, m) or (runs, m, m); ``LRi`` the
+    whitening of a constant R (None: R whitened here). Diagnostics ``weights``, ``iterations``, ``converged``,
+    ``innovation_covariance`` (H P⁻ Hᵀ + R).
+    """
+    if P.ndim == 2:
+        P = np.broadcast_to(P, (innovation.shape[0],) + P.shape)
+    dx, P_post, weights, iterations, converged = huber_correct(
+        None, P, innovation, H, R, gamma=gamma, tol=tol, max_iter=max_iter, LRi=LRi)
+    HT = np.swapaxes(H, -1, -2)
+    S = H @ P @ HT + R  # innovation covariance of the prior (the Kalman start of the regression)
+    return dx, P_post, {"weights": weights, "iterations": iterations, "converged": converged,
+                        "innovation_covariance": S}
+
+
+class HuberStrategy:
+    """Huber's M-estimation as a correction *strategy*: composed onto any filter of the Kalman core
+    (:func:`~hinfnav.estimators.strategies.compose`; ``correction="huber"``), whatever its moment rule.
+
+    On the linearised rule it is :class:`HuberCorrection`'s correction, bitwise; on the sigma-point rule it
+    runs on the statistical linearisation (M1) of :mod:`hinfnav.estimators.moments` (the Huber-based
+    sigma-point filter of Karlgaard & Schaub 2007). Parameters as :class:`HuberFilter`'s.
+
+    Parameters
+    ----------
+    gamma : float
+        Huber threshold on the whitened residuals (> 0), 1.345 by default.
+    tol : float
+        Convergence tolerance of the M-estimation (> 0).
+    max_iter : int
+        Iterations per update (≥ 1).
+    """
+
+    name = "huber"
+
+    def __init__(self, gamma: float = 1.345, tol: float = 1e-10, max_iter: int = 50) -> None:
+        self.gamma = as_positive("gamma", gamma)
+        self.tol = as_positive("tol", tol)
+        self.max_iter = as_int_at_least("max_iter", max_iter, 1)
+
+    def __repr__(self) -> str:
+        return f"HuberStrategy(gamma={self.gamma}, tol={self.tol}, max_iter={self.max_iter})"
+
+    def bind(self, estimator: Any) -> None:
+        """Check that ``estimator`` can take this correction (none needed: R may depend on the reading)."""
+
+    def correct_error(self, estimator: Any, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64],
+                      innovation: NDArray[np.float64], x: NDArray[np.float64] | None = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+        """``(δx, P⁺, diagnostics)`` of :func:`huber_correct_error` (P per run; the prior estimate x is not used)."""
+        LRi = whitening(R) if R is estimator.R else None  # the constant R whitened as HuberCorrection does
+        return huber_correct_error(P, H, R, innovation, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
+                                   LRi=LRi)
 
 
 class HuberCorrection:
@@ -83,15 +142,8 @@ class HuberCorrection:
 
     def correct_error(self, P: NDArray[np.float64], H: NDArray[np.float64], R: NDArray[np.float64], innovation: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
         """Huber M-estimation of the correction δx; returns ``(δx, P⁺, diagnostics)`` (P per run)."""
-        if P.ndim == 2:
-            P = np.broadcast_to(P, (innovation.shape[0],) + P.shape)
-        dx, P_post, weights, iterations, converged = huber_correct(
-            None, P, innovation, H, R, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
-            LRi=self._LRi if R is self.R else None)
-        HT = np.swapaxes(H, -1, -2)
-        S = H @ P @ HT + R  # innovation covariance of the prior (the Kalman start of the regression)
-        return dx, P_post, {"weights": weights, "iterations": iterations, "converged": converged,
-                            "innovation_covariance": S}
+        return huber_correct_error(P, H, R, innovation, gamma=self.gamma, tol=self.tol, max_iter=self.max_iter,
+                                   LRi=self._LRi if R is self.R else None)
 
 
 class HuberFilter(HuberCorrection, ExtendedKalmanFilter):

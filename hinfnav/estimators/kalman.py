@@ -33,7 +33,12 @@ variants override small hooks:
   unless the measurement's covariance depends on its reading (a converted
   range/angle measurement: ``J R Jᵀ`` at each reading);
 * the system it is built on (augmented and extended-state filters append
-  states to it).
+  states to it);
+* :attr:`~KalmanCore.moment_rule` — how the moments of the predicted reading are computed
+  (:mod:`hinfnav.estimators.moments`): linearised here (``observe``), the unscented transform for
+  :class:`~hinfnav.estimators.sigma_point.SigmaPointFilter`; and the strategies
+  :attr:`~KalmanCore.correction_rule` / :attr:`~KalmanCore.fading_rule` composed onto a built filter
+  (:mod:`hinfnav.estimators.strategies`) in place of ``correct_error`` / ``complete_prior``.
 
 With a linear measurement and one initial covariance for all runs the
 covariance and gain do not depend on the data: P is then carried once (2-D)
@@ -56,6 +61,7 @@ from .adaptive import RateAdaptive, StrongTracking
 from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
 from .correction import KalmanCorrection, drop_missing
 from .gate import GateOption
+from .moments import LINEARISED
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
@@ -69,6 +75,12 @@ OUTPUTS = ("filtered", "predicted")
 
 #: Keys of ``FilterState.extra`` that live from one step to the next only.
 _TRANSIENT = ("prior", "PhiPPhiT", "Qd")
+
+
+def _finite_reading_R(mask, R_k):
+    """``mask`` without the runs whose reading-dependent R is not finite on the channels they have."""
+    both = mask[:, :, None] & mask[:, None, :]
+    return mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
 
 
 class KalmanCore(GateOption, KalmanCorrection, Estimator):
@@ -95,6 +107,20 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
     transient_keys = _TRANSIENT
     #: R(y) of a measurement whose noise covariance depends on its reading (None: the constant R)
     R_of_reading = None
+    #: How the moments of the predicted reading are computed (:mod:`hinfnav.estimators.moments`): linearised here,
+    #: the unscented transform for :class:`~hinfnav.estimators.sigma_point.SigmaPointFilter`
+    moment_rule = LINEARISED
+    #: A correction strategy set by :func:`~hinfnav.estimators.strategies.compose` (None: the class's own
+    #: ``correct_error``)
+    correction_rule = None
+    #: A prior-fading strategy set by :func:`~hinfnav.estimators.strategies.compose` (None: the class's own
+    #: ``complete_prior``)
+    fading_rule = None
+
+    @property
+    def strategies(self) -> tuple[str, ...]:
+        """Names of the strategies composed onto this filter's class (empty: the class as written)."""
+        return tuple(rule.name for rule in (self.correction_rule, self.fading_rule) if rule is not None)
 
     @property
     def n_cov(self) -> int:
@@ -135,13 +161,16 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
 
         Called only when :attr:`defers_prior` is set; ``innovation`` and ``H``
         are zero on the channels ``~mask`` a reading lacks (mask None: none).
-        Strong tracking (:class:`~hinfnav.estimators.adaptive.StrongTracking`) overrides it.
+        Strong tracking (:class:`~hinfnav.estimators.adaptive.StrongTracking`) overrides it; a composed fading
+        strategy (:attr:`fading_rule`) replaces it.
         """
+        if self.fading_rule is not None:
+            return self.fading_rule.complete_prior(self, PhiPPhiT, Qd, state, innovation, H, mask=mask)
         return PhiPPhiT + Qd, {}, {}
 
     def initial_diagnostics(self, runs: int) -> dict[str, Any]:
-        """Diagnostics every step reports, at their values before any prediction (none here)."""
-        return {}
+        """Diagnostics every step reports, at their values before any prediction (a fading strategy's here)."""
+        return {} if self.fading_rule is None else self.fading_rule.initial_diagnostics(self, runs)
 
     def step_diagnostics(self, state: FilterState) -> dict[str, Any]:
         """Diagnostics that depend on the prior ``state`` (none here)."""
@@ -180,7 +209,11 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
         (runs, m, n) otherwise; ``R`` is the step's covariance when it depends
         on the reading or on the missing channels (default the constant :attr:`R`).
         """
-        dx, P_post, diag = self.correct_error(P, H, self.R if R is None else R, innovation)
+        R = self.R if R is None else R
+        if self.correction_rule is not None:  # a composed correction strategy
+            dx, P_post, diag = self.correction_rule.correct_error(self, P, H, R, innovation, x)
+        else:
+            dx, P_post, diag = self.correct_error(P, H, R, innovation)
         return self.inject(x, dx), P_post, diag
 
     # -- the step contract --------------------------------------------------------
@@ -188,6 +221,8 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
     def _start(self, xhat0, P0, runs):
         """x̂ of every run at ``initial_internal(xhat0)``; P = P0 (the filter's default when None), one per run
         unless the covariance is shared."""
+        if self.fading_rule is not None:
+            self.fading_rule.check_runs(runs)
         P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
         x0 = self.initial_internal(np.asarray(xhat0, dtype=float))
         x = np.broadcast_to(x0, (runs, x0.size)).copy()
@@ -196,43 +231,54 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
         return FilterState(x=x, P=P)
 
     def _update(self, state, y):
-        """The one update of the Kalman core: predicted reading, deferred prior, correction, report."""
+        """The one update of the Kalman core: moments of the predicted reading (the :attr:`moment_rule`),
+        deferred prior, gate, correction, report."""
         x, P = state.x, state.P
         runs = x.shape[0]
         mask = available_channels(y) if self.missing == "skip" else None
-        try:
-            yhat, H = self.observe(x)
-            # a missing channel reads as predicted (innovation 0; removed below)
-            y, mask = fill_missing(self.measurement, y, x, yhat, mask)
-            innovation = self.measurement.residual(y, yhat)
-        except ModelFunctionError:  # a user model's own error, already naming its function
-            raise
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {state.k}: the estimate reached a singular point ({exc})") from None
+        rule = self.moment_rule
+        mom, y, mask, innovation = self._moments_at(rule, x, P, y, mask, state.k)
+        H = mom.H
         R_k = self.measurement_covariance(y, x)
+        R_full = self.R if R_k is None else R_k
+        if rule.sigma_points and mask is not None and R_k is not None:
+            mask = _finite_reading_R(mask, R_k)  # R(y) not finite on the channels it has: the reading is not used
         diag_prior = self.initial_diagnostics(runs)
         diag_prior.update(self.step_diagnostics(state))
         extra = {key: val for key, val in state.extra.items() if key not in self.transient_keys}
         if "PhiPPhiT" in state.extra:  # a deferred prior (defers_prior): completed with this reading
-            _, H_0, _, used_0 = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+            if rule.sigma_points:  # the regression (M1) of the moments at the uncompleted prior
+                H_0, _, used_0 = rule.linearisation(P, mom, R_full, innovation, mask)
+            else:
+                _, H_0, _, used_0 = drop_missing(P, H, R_full, innovation, mask)
             P, d_hook, e_hook = self.complete_prior(state.extra["PhiPPhiT"], state.extra["Qd"], state, used_0, H_0,
                                                     mask=mask)
             diag_prior.update(d_hook)
             extra.update(e_hook)
+        if rule.sigma_points:
+            if self._gate is not None:  # a run recovering from rejections: its prior inflated before the points
+                P = self._gate.inflate(P, state.extra.get("gate_count"))
+            if P is not state.P:  # the points redrawn from the completed (or inflated) prior
+                mom, _, _, innovation = self._moments_at(rule, x, P, y, None, state.k)
         shown = mask  # the channels the reading has (a rejected channel's innovation is still reported)
         if self._gate is not None:
-            P, mask, d_gate, e_gate = self._gate.screen(P, H, self.R if R_k is None else R_k, innovation, mask,
-                                                        state.extra.get("gate_count"))
+            if rule.sigma_points:
+                P, mask, d_gate, e_gate = rule.screen(self._gate, mom, R_full, innovation, mask,
+                                                      state.extra.get("gate_count"), P)
+            else:
+                P, mask, d_gate, e_gate = self._gate.screen(P, H, R_full, innovation, mask,
+                                                            state.extra.get("gate_count"))
             diag_prior.update(d_gate)
             extra.update(e_gate)
         try:
-            if mask is None:
+            if rule.sigma_points:
+                x_post, P_post, diag = rule.correct(self, x, P, mom, innovation, R_full, mask, state)
+            elif mask is None:
                 x_post, P_post, diag = self.correct(x, P, H, innovation, state, R=R_k)
             else:
-                if R_k is not None:  # a reading-dependent R not finite on the channels it has: the reading is not used
-                    both = mask[:, :, None] & mask[:, None, :]
-                    mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
-                P, H_used, R_used, used = drop_missing(P, H, self.R if R_k is None else R_k, innovation, mask)
+                if R_k is not None:
+                    mask = _finite_reading_R(mask, R_k)
+                P, H_used, R_used, used = drop_missing(P, H, R_full, innovation, mask)
                 x_post, P_post, diag = self.correct(x, P, H_used, used, state, R=R_used)
         except np.linalg.LinAlgError:
             if not self.refuse_nonfinite:
@@ -249,6 +295,20 @@ class KalmanCore(GateOption, KalmanCorrection, Estimator):
             return new, StepOutput(xhat=self.report(x_post), P=self._broadcast(self.report_covariance(P_post), runs),
                                    diagnostics=diag)
         return new, StepOutput(xhat=self.report(x), P=self._broadcast(self.report_covariance(P), runs), diagnostics=diag)
+
+    def _moments_at(self, rule, x, P, y, mask, k):
+        """``(moments, y, mask, innovation)`` at the prior (x, P): a missing channel reads as predicted
+        (innovation 0; removed at the correction)."""
+        try:
+            mom = rule.measurement_moments(self, x, P, k)
+            if mask is not None:
+                y, mask = fill_missing(self.measurement, y, x, mom.yhat, mask)
+            innovation = self.measurement.residual(y, mom.yhat)
+        except ModelFunctionError:  # a user model's own error, already naming its function
+            raise
+        except InputError as exc:
+            raise HinfnavError(f"filter {self.name!r} stopped at step {k}: the estimate reached a singular point ({exc})") from None
+        return mom, y, mask, innovation
 
     def _broadcast(self, P, runs):
         return np.broadcast_to(P, (runs,) + P.shape) if P.ndim == 2 else P

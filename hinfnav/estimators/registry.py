@@ -30,11 +30,12 @@ from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..core.validation import as_choice
 from .sqrt import FORMS, square_root
+from .strategies import as_strategy, compose
 
 if TYPE_CHECKING:
     from .base import Estimator
 
-__all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
+__all__ = ["register_estimator", "register_composition", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
            "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS", "CORE_OPTIONS"]
 
 #: Options every estimator takes whatever its builder (issue 36): applied by :func:`build_estimator` to the built
@@ -129,6 +130,8 @@ class _Entry:
     fits: object
     description: str
     requires: Requires | None = None
+    #: A composition's base estimator and its strategies (:func:`register_composition`); None: a builder of its own
+    composed: tuple | None = None
 
 
 _REGISTRY = {}
@@ -197,6 +200,28 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description, requires)
 
 
+def register_composition(name: str, base: str, *, correction: Any = None, fading: Any = None,
+                         description: str = "") -> None:
+    """Register ``name`` as the estimator ``base`` with strategies composed onto it
+    (:func:`~hinfnav.estimators.strategies.compose`): e.g. ``register_composition("huber_ukf", "ukf",
+    correction="huber")``.
+
+    The composition fits the scenarios ``base`` fits and takes ``base``'s options; ``correction``/``fading``
+    given to :func:`build_estimator` replace its defaults (e.g. ``correction={"name": "huber", "gamma": 2.0}``).
+    ``base`` must be registered first.
+    """
+    entry = estimator_entry(base)
+    if correction is None and fading is None:
+        raise InputError(f"a composition names a correction or a fading strategy; {name!r} has neither")
+    parts = [str(part if isinstance(part, str) else getattr(part, "name", part)) for part in (correction, fading)
+             if part is not None]
+    as_strategy("correction", correction), as_strategy("fading", fading)  # checked now, built at each build
+    register_estimator(name, entry.builder, fits=entry.fits, requires=entry.requires,
+                       description=description or f"{base} composed with {' and '.join(parts)}")
+    _REGISTRY[name] = _Entry(name, entry.builder, entry.fits, _REGISTRY[name].description, entry.requires,
+                             composed=(base, correction, fading))
+
+
 @scenario_moved("name", "scenario", was=str)
 def fit_reason(scenario: Any, name: str) -> str | None:
     """Why the estimator ``name`` does not fit ``scenario`` (None: it fits).
@@ -237,8 +262,14 @@ def estimator_entry(name: str) -> _Entry:
 
 
 @scenario_moved("name", "scenario", was=str)
-def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph", **options: Any) -> Estimator:
+def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph", correction: Any = None,
+                    fading: Any = None, **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``.
+
+    ``correction`` (``"huber"``) and ``fading`` (``"strong_tracking"``): strategies composed onto the filter built
+    (:func:`~hinfnav.estimators.strategies.compose`; a name, a dict ``{"name": …, **parameters}`` or an instance),
+    e.g. ``build_estimator(scenario, "ukf", correction="huber")``; for a registered composition they replace its
+    own (:func:`register_composition`).
 
     ``covariance_form="sqrt"`` gives its square-root (Cholesky-factor) form
     (:func:`~hinfnav.estimators.sqrt.square_root`; an InputError for a filter without one). ``options`` go to
@@ -264,6 +295,15 @@ def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph"
         raise InputError(f"filter {name!r} has no option {bad.group(1)!r}; its options: "
                          f"{', '.join(_builder_options(entry.builder)) or 'none'} (and {', '.join(CORE_OPTIONS)}, "
                          "which every filter takes)") from None
+    if entry.composed is not None:
+        base, correction_0, fading_0 = entry.composed
+        correction = correction_0 if correction is None else correction
+        fading = fading_0 if fading is None else fading
+    if correction is not None or fading is not None:
+        if form != "joseph":
+            raise InputError(f"covariance_form='sqrt': filter {name!r} with composed strategies has no square-root "
+                             "form here")
+        est = compose(est, correction=correction, fading=fading, name=name if entry.composed is not None else None)
     if "missing" in core:
         est.missing = core["missing"]  # the contract's property checks the value and names it
     if gate is not None:  # a χ² innovation gate (hinfnav.estimators.gate)

@@ -47,6 +47,13 @@ coordinates (e.g. ``Δt Γ Q_c Γᵀ``).
 
 Diagnostics at each step: ``innovation`` ν (runs, m) and
 ``innovation_covariance`` S (runs, m, m).
+
+**On the Kalman core.** The transform is a *moment rule* (:class:`SigmaPointRule`,
+:mod:`hinfnav.estimators.moments`): :class:`SigmaPointFilter` is
+:class:`~hinfnav.estimators.kalman.KalmanCore` with this rule for its prediction (U4)/(U6) and for the moments
+of the predicted reading (U5); the core does the rest (missing channels, the χ² gate, the deferred prior, the
+report). So the ideas of the core apply to it as they are: Huber's correction and strong tracking's fading
+(:func:`~hinfnav.estimators.strategies.compose`) read (U5)'s moments through the statistical linearisation (M1).
 """
 
 from __future__ import annotations
@@ -54,23 +61,24 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import HinfnavError, InputError, ModelFunctionError
 from ..core.linalg import as_covariance, inv_spd
 from ..core.validation import as_choice, as_nonnegative, as_positive, as_real, as_vector
 from ..systems.attitude import quat_conjugate, quat_multiply, rotvec_from_quat
 from ..systems.state import StateSpec
-from .base import Estimator, FilterState, StepOutput, available_channels, fill_missing
-from .gate import GateOption
-from .kalman import OUTPUTS, ExtendedKalmanFilter
+from .base import FilterState
+from .correction import KalmanCorrection
+from .kalman import OUTPUTS, ExtendedKalmanFilter, KalmanCore
+from .moments import Moments, statistical_linearisation
 
 if TYPE_CHECKING:
     from ..systems.dynamics import DynamicsModel
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["RULES", "SigmaPointFilter", "merwe_weights", "sigma_points"]
+__all__ = ["RULES", "SigmaPointFilter", "SigmaPointRule", "merwe_weights", "sigma_points"]
 
 #: Sigma-point rules: van der Merwe's scaled unscented set, or the spherical-radial cubature rule.
 RULES = ("unscented", "cubature")
@@ -100,8 +108,166 @@ def sigma_points(x, P, scale, center=True):
     return np.concatenate(parts, axis=1)
 
 
-class SigmaPointFilter(GateOption, Estimator):
-    """Unscented (or cubature) Kalman filter of any dynamics and measurement model (see the module docstring).
+def _without(mask, dY, R_k, innovation):
+    """``(dY, R, ν)`` with the channels ``~mask`` removed exactly, as drop_missing does for the Kalman
+    correction: their output deviations and innovation zeroed, their rows and columns of R decoupled (S block
+    diagonal, K's column 0), so the rest of the update is the filter's without them (mask None: all kept)."""
+    if mask is None:
+        return dY, R_k, innovation
+    both = mask[:, :, None] & mask[:, None, :]
+    return (np.where(mask[:, None, :], dY, 0.0), np.where(both, R_k, 0.0) + np.eye(R_k.shape[-1]) * ~mask[:, None, :],
+            np.where(mask, innovation, 0.0))
+
+
+class SigmaPointRule:
+    """The sigma-point moment rule: (U1)–(U3) points, (U4)/(U6) prediction, (U5) moments of the reading.
+
+    Parameters
+    ----------
+    n : int
+        Dimension of the covariance (the error coordinates).
+    rule : {"unscented", "cubature"}
+    alpha, beta, kappa : float
+        Of the scaled unscented set (U2) (see :class:`SigmaPointFilter`).
+    """
+
+    #: The moments are drawn from P⁻ (the core redraws them from a completed or inflated prior)
+    sigma_points = True
+
+    def __init__(self, n: int, rule: str = "unscented", alpha: float = 1.0, beta: float = 2.0, kappa: float = 0.0) -> None:
+        self.rule = as_choice("rule", rule, RULES)
+        self.alpha, self.beta, self.kappa = as_positive("alpha", alpha), as_nonnegative("beta", beta), as_real("kappa", kappa)
+        if self.rule == "unscented":
+            self.scale, self.Wm, self.Wc = merwe_weights(n, self.alpha, self.beta, self.kappa)
+        else:
+            self.scale, self.Wm = float(n), np.full(2 * n, 0.5 / n)
+            self.Wc = self.Wm
+
+    @property
+    def name(self) -> str:
+        return self.rule
+
+    def __repr__(self) -> str:
+        return f"SigmaPointRule({self.rule!r}, alpha={self.alpha}, beta={self.beta}, kappa={self.kappa})"
+
+    # -- the transform ----------------------------------------------------------------
+
+    def points(self, core, P, k, what):
+        """Sigma-point offsets (runs, N, n_cov) of covariances P: (U1)/(U3) about zero."""
+        try:
+            return sigma_points(np.zeros(P.shape[:-1]), P, self.scale, center=self.rule == "unscented")
+        except np.linalg.LinAlgError:
+            raise HinfnavError(f"filter {core.name!r} stopped at step {k}: the {what} covariance is not positive "
+                               "definite (no sigma points)") from None
+
+    def mean_deviations(self, X):
+        """Weighted mean and deviations of state sigma points X (runs, N, n)."""
+        mean = self.Wm @ X
+        return mean, X - mean[:, None, :]
+
+    def cov(self, A, B):
+        """``Σ W_i^c A_i B_iᵀ`` for deviations A (runs, N, a), B (runs, N, b)."""
+        return np.swapaxes(A * self.Wc[:, None], -1, -2) @ B
+
+    def outputs(self, core, X, x, k):
+        """``(ȳ, dY)``: the weighted mean (runs, m) of h at the sigma points X (runs, N, n) and their deviations.
+
+        The mean is taken about ``h(x̂⁻)`` (the first point for the unscented rule). A measurement function
+        that refuses a point (InputError) stops the filter with a HinfnavError naming step ``k``.
+        """
+        runs, N, n = X.shape
+        meas = core.measurement
+        try:
+            Y = meas.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
+            ref = Y[:, 0] if self.rule == "unscented" else meas.function(x)  # h(x̂⁻)
+        except ModelFunctionError:  # a user model's own error, already naming its function
+            raise
+        except InputError as exc:
+            raise HinfnavError(f"filter {core.name!r} stopped at step {k}: a sigma point reached a singular "
+                               f"point of the measurement ({exc})") from None
+        # differences of predicted outputs: the model's residual (angles wrapped), except for a converted
+        # measurement, whose residual converts a reading (its predicted outputs are positions: plain differences)
+        diff = np.subtract if hasattr(meas, "convert") else meas.residual
+        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
+        return y_mean, diff(Y, y_mean[:, None, :])
+
+    # -- the rule's two uses by the core -------------------------------------------------
+
+    def measurement_moments(self, core, x, P, k):
+        """``Moments(ȳ, None, dX, dY)`` of the reading at the prior (x (runs, n_x), P (runs, n, n)) (U5)."""
+        dX = self.points(core, P, k, "prior")
+        X = core.inject(x[:, None, :], dX)
+        y_mean, dY = self.outputs(core, X, x, k)
+        return Moments(y_mean, None, dX, dY)
+
+    def predict(self, core, state, u):
+        """(U4), or (U6) in error coordinates: the prior of the next step (``P⁻ = Σ W^c dX dXᵀ + Q``; its two
+        terms kept for the next reading when the core ``defers_prior``)."""
+        if core.uses_input and u is None:
+            raise InputError(f"filter {core.name!r} uses the applied input: predict needs u")
+        runs, n = state.x.shape
+        X = core.inject(state.x[:, None, :], self.points(core, state.P, state.k, "posterior"))
+        N = X.shape[1]
+        uu = None
+        if core.uses_input:
+            u = np.asarray(u, dtype=float)
+            uu = np.repeat(u, N, axis=0)
+        t = state.k * core.dt
+        Xf = core.propagate_points(X.reshape(runs * N, n), uu, t).reshape(runs, N, n)
+        if not core.error_coordinates:
+            x, dX = self.mean_deviations(Xf)
+        else:  # (U6): deviations about the propagated centre, their weighted mean injected
+            ref = Xf[:, 0] if self.rule == "unscented" else core.propagate_points(state.x, u, t)
+            D = core.difference(Xf, ref[:, None, :])
+            mean = self.Wm @ D
+            x, dX = core.inject(ref, mean), D - mean[:, None, :]
+        extra = {key: val for key, val in state.extra.items() if key not in core.transient_keys}
+        PhiPPhiT = self.cov(dX, dX)
+        if core.defers_prior:  # Σ W^c dX dXᵀ and Q_d kept for complete_prior at the next reading
+            Qd, e_noise = core.process_noise(state)
+            extra.update(e_noise, PhiPPhiT=PhiPPhiT, Qd=Qd)
+            P = PhiPPhiT + Qd
+        else:
+            P = PhiPPhiT + core.Q
+        return FilterState(x=x, P=P, k=state.k + 1, extra=extra)
+
+    def linearisation(self, P, mom, R, innovation, mask):
+        """``(H̃, R̃, ν)`` of (M1) with the channels ``~mask`` removed, from the moments at the prior P."""
+        dY, R_u, nu = _without(mask, mom.dY, R, innovation)
+        S = self.cov(dY, dY) + R_u
+        H, R_eff = statistical_linearisation(P, self.cov(mom.dX, dY), S)
+        return H, R_eff, nu
+
+    def screen(self, gate, mom, R, innovation, mask, count, P):
+        """The χ² gate on (U5)'s S (the prior P already inflated); returns ``(P, mask, diagnostics, extra)`` as
+        :meth:`~hinfnav.estimators.gate.ChiSquareGate.screen`."""
+        dY, R_u, nu = _without(mask, mom.dY, R, innovation)
+        S = self.cov(dY, dY) + R_u
+        avail = np.ones(innovation.shape, dtype=bool) if mask is None else mask
+        rejected, d_gate, new_count = gate.decide(S, nu, avail, count)
+        if rejected.any():
+            mask = avail & ~rejected
+        return P, mask, d_gate, {"gate_count": new_count}
+
+    def correct(self, core, x, P, mom, innovation, R, mask, state):
+        """``(x⁺, P⁺, diagnostics)``: (U5) ``K = P_xy S⁻¹``, ``P⁺ = P⁻ − K S Kᵀ`` for the plain Kalman
+        correction; any other correction (a composed strategy, a class's own ``correct_error``) on the
+        statistical linearisation (M1) of the same moments."""
+        dY, R_u, nu = _without(mask, mom.dY, R, innovation)
+        S = self.cov(dY, dY) + R_u
+        Pxy = self.cov(mom.dX, dY)
+        if core.correction_rule is not None or type(core).correct_error is not KalmanCorrection.correct_error:
+            H, R_eff = statistical_linearisation(P, Pxy, S)
+            return core.correct(x, P, H, nu, state, R=R_eff)
+        K = Pxy @ inv_spd(S)
+        x_post = core.inject(x, (K @ nu[:, :, None])[:, :, 0])
+        P_post = P - K @ S @ np.swapaxes(K, -1, -2)
+        return x_post, 0.5 * (P_post + np.swapaxes(P_post, -1, -2)), {"innovation_covariance": S}
+
+
+class SigmaPointFilter(KalmanCore):
+    """Unscented (or cubature) Kalman filter of any dynamics and measurement model (see the module docstring):
+    the Kalman core with the sigma-point moment rule (:class:`SigmaPointRule`).
 
     Parameters
     ----------
@@ -132,6 +298,8 @@ class SigmaPointFilter(GateOption, Estimator):
 
     #: The compiled kernel of this class (:mod:`hinfnav.estimators.compiled`; declared per class, not inherited).
     compiled_kernel = "sigma_point"
+    #: P⁺ = P⁻ − K S Kᵀ symmetrised (U5)
+    symmetric_posterior = True
 
     def __init__(self, system: LinearSystem | DynamicsModel, measurement: MeasurementModel, *, P0: ArrayLike, Q: ArrayLike | None = None,
                  R: ArrayLike | None = None, rule: str = "unscented", alpha: float = 1.0, beta: float = 2.0, kappa: float = 0.0,
@@ -156,17 +324,53 @@ class SigmaPointFilter(GateOption, Estimator):
         self.R = (None if self.R_of_reading is not None
                   else as_covariance("R", measurement.R if R is None else R, m, definite=True))
         self.P0 = as_covariance("P0", P0, n, definite=True)
-        self.rule = as_choice("rule", rule, RULES)
-        self.alpha, self.beta, self.kappa = as_positive("alpha", alpha), as_nonnegative("beta", beta), as_real("kappa", kappa)
-        if self.rule == "unscented":
-            self.scale, self.Wm, self.Wc = merwe_weights(n, self.alpha, self.beta, self.kappa)
-        else:
-            self.scale, self.Wm = float(n), np.full(2 * n, 0.5 / n)
-            self.Wc = self.Wm
+        self.moment_rule = SigmaPointRule(n, rule, alpha, beta, kappa)
         if not isinstance(uses_input, (bool, np.bool_)):
             raise InputError(f"uses_input must be True or False; got {uses_input!r}")
         self.uses_input = bool(uses_input)
         self.output = as_choice("output", output, OUTPUTS)
+
+    # the rule's parameters, read by the compiled kernel, the square-root form and the smoothers
+
+    @property
+    def rule(self) -> str:
+        """The sigma-point rule, "unscented" or "cubature"."""
+        return self.moment_rule.rule
+
+    @property
+    def alpha(self) -> float:
+        """α of (U2)."""
+        return self.moment_rule.alpha
+
+    @property
+    def beta(self) -> float:
+        """β of (U2)."""
+        return self.moment_rule.beta
+
+    @property
+    def kappa(self) -> float:
+        """κ of (U2)."""
+        return self.moment_rule.kappa
+
+    @property
+    def scale(self) -> float:
+        """n + λ of (U1) (n for the cubature rule)."""
+        return self.moment_rule.scale
+
+    @property
+    def Wm(self) -> NDArray[np.float64]:
+        """Mean weights W^m of (U2)."""
+        return self.moment_rule.Wm
+
+    @property
+    def Wc(self) -> NDArray[np.float64]:
+        """Covariance weights W^c of (U2)."""
+        return self.moment_rule.Wc
+
+    @property
+    def shares_covariance(self) -> bool:
+        """False: every run carries its own covariance (its sigma points depend on its estimate)."""
+        return False
 
     @classmethod
     def from_ekf(cls, ekf: ExtendedKalmanFilter, *, name: str | None = None, **options: Any) -> SigmaPointFilter:
@@ -180,144 +384,53 @@ class SigmaPointFilter(GateOption, Estimator):
         return cls(ekf.system, ekf.measurement, P0=ekf.P0, Q=ekf.Q, R=ekf.R, uses_input=ekf.uses_input,
                    output=ekf.output, name=name if name is not None else "ukf", **options)
 
-    # -- the transform -------------------------------------------------------------
+    # -- model hooks of the core ---------------------------------------------------------
 
-    def _points(self, P, k, what):
-        """Sigma-point offsets (runs, N, n_cov) of covariances P: (U1)/(U3) about zero."""
-        try:
-            return sigma_points(np.zeros(P.shape[:-1]), P, self.scale, center=self.rule == "unscented")
-        except np.linalg.LinAlgError:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {k}: the {what} covariance is not positive "
-                               "definite (no sigma points)") from None
-
-    def _moments(self, X):
-        """Weighted mean and deviations of state sigma points X (runs, N, n)."""
-        mean = self.Wm @ X
-        return mean, X - mean[:, None, :]
-
-    def _inject(self, x, dx):
+    def inject(self, x: NDArray[np.float64], dx: NDArray[np.float64]) -> NDArray[np.float64]:
         """``x ⊞ δx``: x + δx, or the system's injection (``q ← δq(δθ) ⊗ q``, the rest added)."""
         return x + dx if not self.error_coordinates else self.system.inject(np.broadcast_to(x, dx.shape[:-1] + x.shape[-1:]), dx)
 
-    def _difference(self, x, ref):
-        """``x ⊟ ref``, the inverse of :meth:`_inject`: x − ref, or (U6) for a quaternion-first state."""
+    def initial_internal(self, xhat0: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The prior estimate, normalised by the system's injection of a zero correction (a unit quaternion)."""
+        x = as_vector("xhat0", xhat0, self.n_state)
+        return self.inject(x[None, :], np.zeros((1, self.n_cov)))[0] if self.error_coordinates else x
+
+    def difference(self, x: NDArray[np.float64], ref: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``x ⊟ ref``, the inverse of :meth:`inject`: x − ref, or (U6) for a quaternion-first state."""
         if not self.error_coordinates:
             return x - ref
         ref = np.broadcast_to(ref, x.shape)
         dq = quat_multiply(x[..., :4], quat_conjugate(ref[..., :4]))
         return np.concatenate([rotvec_from_quat(dq), x[..., 4:] - ref[..., 4:]], axis=-1)
 
-    def _propagate(self, X, u, t):
+    def propagate_points(self, X: NDArray[np.float64], u: NDArray[np.float64] | None, t: float) -> NDArray[np.float64]:
+        """The dynamics at points X (a batch of states): ``f(X, u, t)``, or the system's ``predict_mean``."""
         if self.error_coordinates:
             return np.asarray(self.system.predict_mean(X, u))
         return np.asarray(self.system.f(X, u, t))
 
-    @staticmethod
-    def _without(mask, dY, R_k, innovation):
-        """``(dY, R, ν)`` with the channels ``~mask`` removed exactly, as drop_missing does for the Kalman
-        correction: their output deviations and innovation zeroed, their rows and columns of R decoupled (S block
-        diagonal, K's column 0), so the rest of the update is the filter's without them (mask None: all kept)."""
-        if mask is None:
-            return dY, R_k, innovation
-        both = mask[:, :, None] & mask[:, None, :]
-        return (np.where(mask[:, None, :], dY, 0.0), np.where(both, R_k, 0.0) + np.eye(R_k.shape[-1]) * ~mask[:, None, :],
-                np.where(mask, innovation, 0.0))
+    def process_noise(self, state: FilterState) -> tuple[np.ndarray, dict[str, Any]]:
+        """``(Q_d, extra)``: the constant :attr:`Q` (the additive process noise of (U4))."""
+        return self.Q, {}
+
+    # -- the transform, for the square-root form and the smoothers -----------------------------
+
+    def _points(self, P, k, what):
+        return self.moment_rule.points(self, P, k, what)
+
+    def _moments(self, X):
+        return self.moment_rule.mean_deviations(X)
 
     def _cov(self, A, B):
-        """``Σ W_i^c A_i B_iᵀ`` for deviations A (runs, N, a), B (runs, N, b)."""
-        return np.swapaxes(A * self.Wc[:, None], -1, -2) @ B
+        return self.moment_rule.cov(A, B)
+
+    def _propagate(self, X, u, t):
+        return self.propagate_points(X, u, t)
+
+    def _predicted_outputs(self, X, x, k):
+        return self.moment_rule.outputs(self, X, x, k)
 
     # -- the step contract -------------------------------------------------------------
 
-    def _start(self, xhat0, P0, runs):
-        P = self.P0 if P0 is None else as_covariance("P0", P0, self.n_cov, definite=True)
-        x = np.broadcast_to(as_vector("xhat0", xhat0, self.n_state), (runs, self.n_state)).copy()
-        if self.error_coordinates:  # the system's injection of a zero correction normalises (a unit quaternion)
-            x = self._inject(x, np.zeros((runs, self.n_cov)))
-        return FilterState(x=x, P=np.broadcast_to(P, (runs,) + P.shape).copy())
-
-    def _predicted_outputs(self, X, x, k):
-        """``(ȳ, dY)``: the weighted mean (runs, m) of h at the sigma points X (runs, N, n) and their deviations.
-
-        The mean is taken about ``h(x̂⁻)`` (the first point for the unscented rule). A measurement function
-        that refuses a point (InputError) stops the filter with a HinfnavError naming step ``k``.
-        """
-        runs, N, n = X.shape
-        try:
-            Y = self.measurement.function(X.reshape(runs * N, n)).reshape(runs, N, -1)
-            ref = Y[:, 0] if self.rule == "unscented" else self.measurement.function(x)  # h(x̂⁻)
-        except ModelFunctionError:  # a user model's own error, already naming its function
-            raise
-        except InputError as exc:
-            raise HinfnavError(f"filter {self.name!r} stopped at step {k}: a sigma point reached a singular "
-                               f"point of the measurement ({exc})") from None
-        # differences of predicted outputs: the model's residual (angles wrapped), except for a converted
-        # measurement, whose residual converts a reading (its predicted outputs are positions: plain differences)
-        diff = np.subtract if hasattr(self.measurement, "convert") else self.measurement.residual
-        y_mean = ref + self.Wm @ diff(Y, ref[:, None, :])
-        return y_mean, diff(Y, y_mean[:, None, :])
-
-    def _update(self, state, y):
-        x, P = state.x, state.P
-        runs, n = x.shape
-        mask = available_channels(y) if self.missing == "skip" else None
-        gate, count = self._gate, state.extra.get("gate_count")
-        if gate is not None:  # a run recovering from rejections: its prior inflated before the points are drawn
-            P = gate.inflate(P, count)
-        dX = self._points(P, state.k, "prior")
-        X = self._inject(x[:, None, :], dX)
-        y_mean, dY = self._predicted_outputs(X, x, state.k)
-        y, mask = fill_missing(self.measurement, y, x, y_mean, mask)  # a missing channel reads as predicted
-        R_k = self.R if self.R_of_reading is None else self.R_of_reading(y)
-        innovation = self.measurement.residual(y, y_mean)
-        if mask is not None and self.R_of_reading is not None:
-            # R(y) not finite on the channels it has: the reading is not used
-            both = mask[:, :, None] & mask[:, None, :]
-            mask = mask & np.all(np.isfinite(np.where(both, R_k, 0.0)), axis=(1, 2))[:, None]
-        shown, raw = mask, innovation  # the channels the reading has (a rejected channel's innovation is reported)
-        dY_u, R_u, nu_u = self._without(mask, dY, R_k, innovation)
-        S = self._cov(dY_u, dY_u) + R_u
-        d_gate = {}
-        if gate is not None:
-            avail = np.ones(innovation.shape, dtype=bool) if mask is None else mask
-            rejected, d_gate, new_count = gate.decide(S, nu_u, avail, count)
-            if rejected.any():
-                mask = avail & ~rejected
-                dY_u, R_u, nu_u = self._without(mask, dY, R_k, innovation)
-                S = self._cov(dY_u, dY_u) + R_u
-        dY, innovation = dY_u, nu_u
-        Pxy = self._cov(dX, dY)
-        K = Pxy @ inv_spd(S)
-        x_post = self._inject(x, (K @ innovation[:, :, None])[:, :, 0])
-        P_post = P - K @ S @ np.swapaxes(K, -1, -2)
-        P_post = 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
-        diag = dict(d_gate, innovation=raw if shown is None else np.where(shown, raw, np.nan), innovation_covariance=S)
-        extra = dict(state.extra)
-        if gate is not None:
-            extra["gate_count"] = new_count
-        new = FilterState(x=x_post, P=P_post, k=state.k, extra=extra)
-        if self.output == "filtered":
-            return new, StepOutput(xhat=x_post, P=P_post, diagnostics=diag)
-        return new, StepOutput(xhat=x, P=P, diagnostics=diag)
-
     def _predict(self, state, u):
-        if self.uses_input and u is None:
-            raise InputError(f"filter {self.name!r} uses the applied input: predict needs u")
-        runs, n = state.x.shape
-        X = self._inject(state.x[:, None, :], self._points(state.P, state.k, "posterior"))
-        N = X.shape[1]
-        uu = None
-        if self.uses_input:
-            u = np.asarray(u, dtype=float)
-            uu = np.repeat(u, N, axis=0)
-        t = state.k * self.dt
-        Xf = self._propagate(X.reshape(runs * N, n), uu, t).reshape(runs, N, n)
-        if not self.error_coordinates:
-            x, dX = self._moments(Xf)
-        else:  # (U6): deviations about the propagated centre, their weighted mean injected
-            ref = Xf[:, 0] if self.rule == "unscented" else self._propagate(state.x, u, t)
-            D = self._difference(Xf, ref[:, None, :])
-            mean = self.Wm @ D
-            x, dX = self._inject(ref, mean), D - mean[:, None, :]
-        P = self._cov(dX, dX) + self.Q
-        return FilterState(x=x, P=P, k=state.k + 1, extra=dict(state.extra))
+        return self.moment_rule.predict(self, state, u)

@@ -154,6 +154,9 @@ def _refuse(estimator: Any) -> None:
             "extended (linearised, data-dependent) filter has not been given here; build a "
             "RecursiveHInfinityFilter on the same linear model and use hinf_smoother.hinf_fixed_lag, or smooth with "
             "the Kalman/EKF, sigma-point or Huber filter")
+    if isinstance(estimator, KalmanCore) and getattr(estimator, "strategies", ()):
+        raise InputError(f"{name} is composed with the {' and '.join(estimator.strategies)} strategy: not smoothed "
+                         "here; smooth the plain filter")
     if isinstance(estimator, SigmaPointFilter):
         if estimator.error_coordinates:
             raise InputError(f"{name} on a state with its own error (a quaternion) is not smoothed: (S2) needs the "

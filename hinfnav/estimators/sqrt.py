@@ -299,6 +299,9 @@ def square_root(estimator: KalmanCore | SigmaPointFilter, *, name: str | None = 
     tracking's fading, error coordinates, the H∞ filters).
     """
     cls = type(estimator)
+    if getattr(estimator, "strategies", ()):
+        raise InputError(f"{estimator.name!r} is composed with the {' and '.join(estimator.strategies)} strategy: no "
+                         "square-root form here")
     if isinstance(estimator, (SquareRootEKF, SquareRootSigmaPointFilter)):
         return estimator
     if isinstance(estimator, SigmaPointFilter) and cls is SigmaPointFilter:

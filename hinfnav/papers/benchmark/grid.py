@@ -58,6 +58,12 @@ def load_papers():
     return out
 
 
+def _as_written(scenario=None):
+    """The registered estimators (fitting ``scenario``) as written: their compositions with strategies
+    (:func:`~hinfnav.estimators.registry.register_composition`) are run when asked for by name."""
+    return tuple(n for n in registered_estimators(scenario) if estimator_entry(n).composed is None)
+
+
 def benchmark_campaign(*, runs=200, seed=0, estimators=None, batch_size=200, maneuvers=(True, False),
                        deltas=DELTAS, noises=NOISES):
     """The benchmark's campaign: every fitting estimator on every cell of the grid.
@@ -83,7 +89,7 @@ def benchmark_campaign(*, runs=200, seed=0, estimators=None, batch_size=200, man
         Its cells' seeds depend on the truth parameters only, so the
         estimators of a grid point share their truths (common random numbers).
     """
-    names = registered_estimators(Scenario()) if estimators is None else tuple(estimators)
+    names = _as_written(Scenario()) if estimators is None else tuple(estimators)
     return Campaign(name="benchmark", runs=runs, seed=seed, batch_size=batch_size, windows=WINDOWS, tol=TOL,
                     grid={"scenario": "sun2011", "estimator": list(names), "maneuver": list(maneuvers),
                           "delta": list(deltas), "noise": list(noises)})
@@ -135,7 +141,7 @@ def scenario_campaign(key, *, runs=50, seed=0, estimators=None, batch_size=50, g
     if estimators is None:
         settings = {k: v[0] for k, v in g.items() if k in scenario_parameters(key)}
         same = spec.get("same_as", {})
-        estimators = [n for n in registered_estimators(build_scenario(key, **settings)) if n not in same]
+        estimators = [n for n in _as_written(build_scenario(key, **settings)) if n not in same]
     return Campaign(name=f"benchmark_{key}", runs=runs, seed=seed, batch_size=batch_size, windows=spec["windows"],
                     tol=spec["tol"], grid={"scenario": key, "estimator": list(estimators), **g})
 
@@ -146,7 +152,7 @@ def non_fitting(key, settings=None):
     sc = build_scenario(key, **(settings or {}))
     same = SCENARIOS.get(key, {}).get("same_as", {})
     out = {}
-    for name in registered_estimators():
+    for name in _as_written():
         why = fit_reason(sc, name)
         if why is None and name in same:
             why = f"not run: on this scenario it is the same filter as {same[name]!r} (identical estimates)"
@@ -172,7 +178,7 @@ def fit_matrix(papers=None):
     papers = load_papers() if papers is None else papers
     scenarios = {key: build_scenario(key) for key in registered_scenarios()}
     out = {}
-    for name in registered_estimators():
+    for name in _as_written():
         why = {key: fit_reason(sc, name) for key, sc in scenarios.items()}
         out[name] = {"description": estimator_entry(name).description, "fits": {k: w is None for k, w in why.items()},
                      "why_not": {k: w for k, w in why.items() if w is not None}}

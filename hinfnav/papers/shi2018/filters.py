@@ -30,7 +30,8 @@ from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_positive
 from ...estimators.huber_filter import HuberFilter, HuberStrongTrackingEKF
 from ...estimators.kalman import ExtendedKalmanFilter, StrongTrackingEKF
-from ...estimators.registry import Requires, build_estimator, estimator_entry, register_estimator, registered_estimators
+from ...estimators.registry import (Requires, build_estimator, estimator_entry, register_composition, register_estimator,
+                                   registered_estimators)
 from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
@@ -229,3 +230,10 @@ register_estimator("stekf", build_stekf, fits=_fits_ukf,
 register_estimator("huber_stekf", build_huber_stekf, fits=_fits_ukf,
                    description="Huber x strong tracking: the strong-tracking EKF with Huber's M-estimation as its "
                                "correction")
+# the sigma-point filter with the core's ideas composed onto it (hinfnav.estimators.strategies): no class of their own
+register_composition("huber_ukf", "ukf", correction="huber",
+                     description="Huber x sigma-point: the ukf with Huber's M-estimation as its correction, on the "
+                                 "statistical linearisation of its moments (gamma = 1.345)")
+register_composition("stukf", "ukf", fading="strong_tracking",
+                     description="strong tracking x sigma-point: the ukf with paper 002's fading factors on its "
+                                 "predicted covariance (rho = 0.95, beta = 1)")
