@@ -144,12 +144,15 @@ def _rebuild_and_certify(P, sol, system, samples, dt, split=False):
     # certificate: (20) at the returned filter (Abar_F = S A_F, Bbar_F = S B_F)
     M0 = lmi20_matrix(P.A, P.B, P.C, P.D, P.L, P.H, P.E, sol.R, sol.S, sol.S @ AFs, sol.S @ BFs, CFs, sol.lam, 0.0)
     p, q = P.B.shape[1], P.D.shape[1]
+    # the eigenvalue test's margin: 1e-13 ‖M‖ (schur_gamma's default) up to N = 90, then 10 N eps ‖M‖, ten times
+    # the rounding bound of a symmetric eigensolver of size N (unchanged for every design below 23 states)
+    tol = max(1e-13, 10.0 * M0.shape[0] * np.finfo(float).eps)
     if d is None:
-        gamma_c, info = schur_gamma(M0, gamma_index(n, p, q))
+        gamma_c, info = schur_gamma(M0, gamma_index(n, p, q), tol)
     else:
         # the eigenvalue test on diag(d) M0 diag(d), exact in floating point (powers of two), proves M0 < 0 with
         # a tolerance relative to the normalised scale instead of γ² of the original data
-        gamma_c, info = schur_gamma(d[:, None] * M0 * d[None, :], gamma_index(n, p, q))
+        gamma_c, info = schur_gamma(d[:, None] * M0 * d[None, :], gamma_index(n, p, q), tol)
         gamma_c *= P_rho_nu
     # undo the state scaling exactly (powers of two): x_f = Σ x̃_f
     if P.form == "observer":
@@ -386,7 +389,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     problems = {}
     # a decoupled plant: LMI (20) with block-diagonal variables, exact (see lmi20_problem); the scalings are diagonal,
     # so every variant has the blocks of P
-    blocks = decoupled_blocks(P.A, P.B, P.C, P.D, P.L, P.H, P.E)
+    blocks = decoupled_blocks(P.A, P.B, P.C, P.D, P.L, P.H, P.E) if options.blocks else []
     split = len(blocks) > 1
 
     def solve(i, slv, level):

@@ -81,6 +81,13 @@ class SolverOptions:
         (:func:`hinfnav.lmi.conditioning.unit_scaling`: the design does not
         depend on them; used by ``design --system``); a tuple gives the
         factors (rounded to powers of two).
+    blocks : bool
+        Pose LMI (20) of a decoupled plant (block-diagonal up to a
+        permutation, :func:`hinfnav.analysis.structure.decoupled_blocks`)
+        with block-diagonal variables, one small matrix inequality per block
+        and a common λ and γ (default True: the same optimum as the full LMI,
+        see :func:`lmi20_problem`; False: one matrix inequality of the whole
+        plant, as before).
     normalize_above : float
         Scale of the noise block (B, D) or of the output block (L) above
         which it is normalised by a power of two before solving, and the
@@ -99,6 +106,7 @@ class SolverOptions:
     polish: bool = False
     state_scaling: object = "balance"
     normalize_above: float = NORMALIZE_THRESHOLD
+    blocks: bool = True
 
     def __post_init__(self):
         solvers = self.solvers
@@ -119,6 +127,8 @@ class SolverOptions:
         object.__setattr__(self, "max_bisection", as_int_at_least("max_bisection", self.max_bisection, 1))
         if not isinstance(self.polish, (bool, np.bool_)):
             raise InputError(f"polish must be True or False; got {self.polish!r}")
+        if not isinstance(self.blocks, (bool, np.bool_)):
+            raise InputError(f"blocks must be True or False; got {self.blocks!r}")
         if isinstance(self.state_scaling, str):
             as_choice("state_scaling", self.state_scaling, ("balance", "units", "none"))
         else:
