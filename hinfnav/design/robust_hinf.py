@@ -332,6 +332,17 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     restriction costs 0.03 % (δ̄ = 0.05) to 3 % (δ̄ = 5) in (20), while
     the filters themselves certify within 3e-8 of γ* at δ̄ = 0.05.
 
+    **Decoupled plants.** When A, B, C, D, L, H, E are block-diagonal up
+    to a permutation (:func:`hinfnav.analysis.structure.decoupled_blocks`;
+    e.g. several vehicles, or axes that do not couple), LMI (20) is posed
+    with block-diagonal variables and a common λ and γ
+    (:func:`hinfnav.lmi.lmi20_problem`: the same optimum as the full LMI,
+    for one full F coupling all blocks); the certificate is evaluated on the
+    full (20), and the sampled norms are taken per block at the samples F
+    that do not couple the blocks (0, ±I, the sign vertices) and on the
+    whole error system at the others (the random full contractions).
+    ``options.blocks=False`` poses the full LMI.
+
     **Scaling.** Noise inputs (B, D, one common factor) and the output (L)
     whose scale exceeds ``options.normalize_above`` are normalised by powers
     of two (:func:`hinfnav.lmi.conditioning.normalize`); the solver's
