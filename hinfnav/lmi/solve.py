@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from .conditioning import Prepared
 
 __all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
-           "run_solver", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi"]
+           "run_solver", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi", "BLOCK_RETRY"]
 
 #: Solvers the synthesis accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")
