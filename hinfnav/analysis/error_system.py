@@ -20,6 +20,7 @@ from ..core.exceptions import InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_matrix
 from .norms import NORM_TOL, _dt_value, hinf_norm
+from .structure import decoupled_blocks
 
 if TYPE_CHECKING:
     from ..systems.uncertain import UncertainSystem
@@ -130,7 +131,7 @@ class WorstCase:
 
 def worst_case_norm(system: UncertainSystem, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike,
                     samples: Sequence[ArrayLike] | None = None, dt: float | bool | None = None,
-                    tol: float = NORM_TOL) -> WorstCase:
+                    tol: float = NORM_TOL, split: bool = False) -> WorstCase:
     """Worst sampled H∞ norm of the error system (13)–(15) of a filter.
 
     Parameters
@@ -146,6 +147,16 @@ def worst_case_norm(system: UncertainSystem, A_F: ArrayLike, B_F: ArrayLike, C_F
         Sampling time of the returned frequencies; default ``system.dt``.
     tol : float, optional
         Relative accuracy of each norm.
+    split : bool, optional
+        Split the error system at each sample into its decoupled blocks
+        (:func:`hinfnav.analysis.structure.decoupled_blocks`: a
+        block-diagonal plant, filter and F) and take the largest block norm
+        and spectral radius, which equal the whole system's (its transfer
+        matrix is block-diagonal up to a permutation of inputs and outputs);
+        blocks with identical matrices are evaluated once. Exact, and at
+        n = 48 (8 blocks of 12 error states) far cheaper than one norm of
+        the 96-state system. A sample that couples the blocks (a full F) is
+        evaluated whole. Default False (the whole system, as before).
 
     Returns
     -------
@@ -157,8 +168,16 @@ def worst_case_norm(system: UncertainSystem, A_F: ArrayLike, B_F: ArrayLike, C_F
         samples = [None]
     dt = system.dt if dt is None else _dt_value(dt)
     norms, radii, peaks = [], [], []
+    cache: dict = {}
     for F in samples:
         Ap = system.A if F is None else system.perturbed_A(F)
+        if split:
+            g, rad, f = _split_norm(error_system_matrices(Ap, system.B, system.C, system.D, system.L, A_F, B_F, C_F),
+                                    dt, tol, cache)
+            norms.append(g)
+            radii.append(rad)
+            peaks.append(f)
+            continue
         sys = error_system(Ap, system.B, system.C, system.D, system.L, A_F, B_F, C_F, dt)
         radii.append(spectral_radius(sys.A))
         g, f = hinf_norm(sys, tol, return_peak=True)
@@ -170,3 +189,29 @@ def worst_case_norm(system: UncertainSystem, A_F: ArrayLike, B_F: ArrayLike, C_F
     return WorstCase(norms, np.array(radii), np.array(peaks), int(np.argmax(norms)))
 
 
+
+
+def _split_norm(matrices, dt, tol, cache):
+    """(norm, spectral radius, peak frequency) of an error system as the worst of its decoupled blocks (internal).
+
+    ``cache`` maps a block's matrices (bytes) to its result, shared across
+    the samples of one :func:`worst_case_norm` call.
+    """
+    Abar, Bbar, Cbar = matrices
+    N = Abar.shape[0]
+    worst = (0.0, 0.0, 0.0)
+    for blk in decoupled_blocks(Abar, Bbar, np.zeros((0, N)), np.zeros((0, 0)), Cbar):
+        i = blk.states
+        Ab, Bb, Cb = Abar[np.ix_(i, i)], Bbar[np.ix_(i, blk.w)], Cbar[np.ix_(blk.z, i)]
+        key = tuple((M.shape, M.tobytes()) for M in (Ab, Bb, Cb))
+        if key not in cache:
+            rad = spectral_radius(Ab)
+            if Bb.size == 0 or Cb.size == 0:
+                cache[key] = (float("inf") if rad >= 1.0 else 0.0, rad, 0.0)
+            else:
+                sys = control.ss(Ab, Bb, Cb, np.zeros((Cb.shape[0], Bb.shape[1])), _dt_value(dt))
+                g, f = hinf_norm(sys, tol, return_peak=True)
+                cache[key] = (g, rad, f)
+        g, rad, f = cache[key]
+        worst = (max(worst[0], g), max(worst[1], rad), f if g > worst[0] else worst[2])
+    return worst
