@@ -71,3 +71,15 @@ def test_cli_refuses_a_design_over_its_time_limit_before_solving():
     assert out.returncode == 2
     assert "estimated" in out.stderr and "exceeds the limit of 0.001 s" in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("name, n, vertices", [("double_integrator", 4, 1), ("two_mass_spring_30pct", 4, 2),
+                                               ("mass_spring_damper_continuous", 2, 2),
+                                               ("flexible_attitude_20pct", 4, 18)])
+def test_system_size_of_every_example(name, n, vertices):
+    # what the estimate is computed from, read from the example files (their [nominal] A and vertex tables)
+    from hinfnav.design.cost import system_size
+    from hinfnav.systems.files import read_system_file
+
+    got = system_size(read_system_file(ROOT / "examples" / f"{name}.toml"))
+    assert got[:2] == (n, vertices)

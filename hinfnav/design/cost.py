@@ -32,9 +32,10 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 from tqdm.auto import tqdm
 
-from ..core.exceptions import InputError
+from ..core.exceptions import InputError, SynthesisError
 from ..io.progress import bar_disabled
 from ..lmi.solve import SCS_BUDGET_S, watch_solves
 
@@ -76,8 +77,9 @@ def system_size(system: Any, lyapunov: str | None = None, form: str = "general")
     """``(n, vertices, lyapunov)`` of a system read from a file, as the design will see it."""
     verts = getattr(system, "vertices", None)
     if verts is not None:
-        A = verts[0].A
-        n, v = A.shape[0], len(verts)
+        v0 = verts[0]
+        A = v0[0] if isinstance(v0, tuple) else v0.A  # a ContinuousPolytope's vertices are (A, B, C, D, L)
+        n, v = np.shape(A)[0], len(verts)
         lyap = lyapunov or "parameter-dependent"
     else:
         n = system.A.shape[0]
@@ -137,7 +139,15 @@ def design_progress(estimate_s: float, *, progress: bool = True, limit_s: float 
         ticker.start()
     try:
         with watch_solves({"SCS": SCS_BUDGET_S}, on_call) as watch:
-            yield watch
+            try:
+                yield watch
+            except SynthesisError as exc:
+                if "SCS" not in watch.spent:
+                    raise
+                # SCS (first-order, loose) is the likely cause: say so and what to use instead, in the same line
+                raise type(exc)(f"{exc} [SCS ran {watch.spent['SCS']:.0f} s of its {SCS_BUDGET_S:g} s budget and its "
+                                "points did not certify: SCS is a first-order solver, loose on these LMIs; use "
+                                "--solver CLARABEL or CVXOPT (the default chain)]") from None
     finally:
         stop.set()
         if ticker.is_alive():
