@@ -567,8 +567,8 @@ def _solve_cases():
             raise RuntimeError("traceback: " + out.stderr[-300:])
         if out.returncode:
             lines = [ln for ln in out.stderr.strip().splitlines() if not ln.startswith(("design (", "note:"))]
-            raise HinfnavError(f"exit {out.returncode}: " + " | ".join(lines))
-        assert "certified" in out.stdout, out.stdout
+            raise HinfnavError(f"exit {out.returncode}: " + " ⏎ ".join(lines))
+        assert "--json" in argv or "certified" in out.stdout, out.stdout
         return out
 
     def scs(argv):
@@ -578,7 +578,8 @@ def _solve_cases():
             return cli(argv)
         except HinfnavError as exc:
             text = str(exc)
-            assert "exit 1" in text and "SCS" in text and "--solver CLARABEL" in text and text.count(" | ") == 0, text
+            assert "exit 1" in text and "SCS ran" in text and "--solver CLARABEL" in text and " ⏎ " not in text, \
+                text[-300:]
 
     examples = ROOT / "examples"
     for name, form in (("double_integrator", "observer"), ("double_integrator_position", "observer"),
