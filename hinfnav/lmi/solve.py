@@ -266,6 +266,30 @@ def watch_solves(budget: dict | None = None, on_call: Callable | None = None) ->
         _WATCH.reset(token)
 
 
+#: SCS's status value for a solve stopped by Ctrl-C (SCS_SIGINT in SCS's glbopts.h; cvxpy maps it to a solver error).
+SCS_SIGINT = -5
+
+
+@contextlib.contextmanager
+def _scs_interrupts() -> Iterator[None]:
+    """While inside, an SCS solve that SCS stopped on Ctrl-C raises KeyboardInterrupt (cvxpy calls ``scs.solve``)."""
+    import scs
+
+    original = scs.solve
+
+    def solve(*args: Any, **kwargs: Any) -> Any:
+        out = original(*args, **kwargs)
+        if out.get("info", {}).get("status_val") == SCS_SIGINT:
+            raise KeyboardInterrupt
+        return out
+
+    scs.solve = solve
+    try:
+        yield
+    finally:
+        scs.solve = original
+
+
 #: Exceptions a cvxpy solve may raise on a hard LMI (CVXOPT raises ArithmeticError from inside LAPACK).
 SOLVER_ERRORS = (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError)
 
@@ -306,8 +330,13 @@ def run_solver(prob: cp.Problem, solver: str, accuracy: float | None = None, ret
                     kwargs["time_limit_secs"] = min(kwargs.get("time_limit_secs", SCS_TIME_LIMIT_S), left)
             calls += 1
             t0 = time.perf_counter()
+            # SCS catches Ctrl-C itself (its own SIGINT handler during a solve) and reports a solver error, so a
+            # design would go on to its next solve: its "interrupted" status is turned back into KeyboardInterrupt
+            # (issue 36), which stops the command as anywhere else
+            hold = _scs_interrupts() if solver == "SCS" else contextlib.nullcontext()
             try:
-                prob.solve(solver=solver, **kwargs)
+                with hold:
+                    prob.solve(solver=solver, **kwargs)
                 status = str(prob.status)
             except SOLVER_ERRORS as exc:
                 status = f"solver error ({exc})"
