@@ -83,3 +83,17 @@ def test_system_size_of_every_example(name, n, vertices):
 
     got = system_size(read_system_file(ROOT / "examples" / f"{name}.toml"))
     assert got[:2] == (n, vertices)
+
+
+def test_an_scs_solve_stopped_by_ctrl_c_stops_the_design(monkeypatch):
+    # SCS handles SIGINT itself and returns status_val -5 (SCS_SIGINT), which cvxpy maps to a solver error: the
+    # design would go on; run_solver turns it back into KeyboardInterrupt (the CLI then prints one line, exit 130)
+    import scs
+
+    def stopped(*args, **kwargs):
+        return {"info": {"status_val": -5}}
+
+    monkeypatch.setattr(scs, "solve", stopped)
+    prob, _ = _tiny()
+    with pytest.raises(KeyboardInterrupt):
+        run_solver(prob, "SCS", 1e-6)

@@ -70,6 +70,21 @@ def test_gamma_scales_with_the_noise(chaser, k):
     np.testing.assert_allclose(out.B_F, res.B_F, rtol=1e-6, atol=1e-9 * np.abs(res.B_F).max())
 
 
+@pytest.mark.parametrize("k", [1e-6, 1e6])
+def test_gamma_scales_with_the_noise_on_the_polytopic_route(k):
+    # the double integrator of examples/ (nominal, not Schur stable: designed in observer form by the extended LMI
+    # (E1), the polytopic route); before: γ 10x loose at k = 1e-6 (certificate's tolerance at γ² ~ 1e-13) and
+    # nothing certified at k = 1e6; now normalised before the solve and certified at the unit scale
+    import dataclasses
+
+    from hinfnav.systems.files import read_system_file
+
+    s = read_system_file(Path(__file__).resolve().parents[1] / "examples" / "double_integrator.toml")
+    g1 = synthesize(s, form="observer", options=UNITS).gamma
+    scaled = dataclasses.replace(s, B=s.B * k, D=s.D * k)
+    assert synthesize(scaled, form="observer", options=UNITS).gamma == pytest.approx(k * g1, rel=1e-6)
+
+
 def _dense_worst_case(s, A_F, B_F, C_F, rng, n_f=60, n_w=2000):
     """Largest σ_max of the error transfer function over random contractions F and a dense frequency grid.
 
