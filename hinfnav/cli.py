@@ -131,7 +131,8 @@ def _cmd_simulate(args):
 #: option that does not apply is refused, not ignored)
 _DESIGN_DEFAULTS = {"delta_bar": 0.05, "points": 12, "form": "general", "objective": "hinf"}
 _FLAG = {"delta_bar": "--delta-bar", "points": "--points", "form": "--form", "objective": "--objective",
-         "solver": "--solver", "lyapunov": "--lyapunov", "gamma": "--gamma", "save": "--save"}
+         "solver": "--solver", "lyapunov": "--lyapunov", "gamma": "--gamma", "save": "--save",
+         "time_limit": "--time-limit"}
 
 
 def _check_design_options(args):
@@ -166,11 +167,24 @@ def _cmd_design(args):
         return _cmd_design_h2(args, save_design)
     if getattr(args, "gamma", None) is not None:
         raise InputError("--gamma applies to --objective h2 (Corollary 1 minimizes gamma itself)")
-    result = design_for_scenario(None, args.delta_bar, solver=args.solver, form=args.form)
+    with _design_watch(args, 6, 1, "common"):  # Sun et al. (2011)'s chaser: 6 states, norm-bounded
+        result = design_for_scenario(None, args.delta_bar, solver=args.solver, form=args.form)
     rep = design_report_from(result)
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
     print(dumps_strict(rep, indent=2) if args.json else format_design_report(rep))
+
+
+def _design_watch(args, n, vertices, lyapunov):
+    """The design's estimated time, progress bar and SCS budget (issue 36 item 5; hinfnav.design.cost)."""
+    from .design.cost import DESIGN_LIMIT_S, design_progress, estimate_design_seconds
+
+    limit = DESIGN_LIMIT_S if args.time_limit is None else args.time_limit
+    if not limit > 0:
+        raise InputError(f"--time-limit must be a number of seconds > 0; got {args.time_limit!r}")
+    est = estimate_design_seconds(n, vertices, lyapunov, args.solver)
+    return design_progress(est, progress=not args.json, limit_s=limit,
+                           what=f"design ({n} states{f', {vertices} vertices' if vertices > 1 else ''})")
 
 
 def _cmd_design_own(args):
@@ -201,8 +215,13 @@ def _cmd_design_own(args):
             raise InputError("--save: a continuous-time design (dt = 0) cannot be saved yet: the design-file format "
                              "and --recertify carry discrete-time certificates only (drop --save; the design is "
                              "certified when it is printed)")
-    result, rep = design_from_system_file(args.system, lyapunov=args.lyapunov, form=args.form,
-                                          objective=args.objective, solver=args.solver)
+    from .design.cost import system_size
+    from .systems.files import read_system_file
+
+    n, vertices, lyap = system_size(read_system_file(args.system), args.lyapunov, args.form)
+    with _design_watch(args, n, vertices, lyap):
+        result, rep = design_from_system_file(args.system, lyapunov=args.lyapunov, form=args.form,
+                                              objective=args.objective, solver=args.solver)
     if args.save:
         rep["saved_to"] = str(save_design(result, result.system, args.save, options={"system_file": args.system}))
     print(dumps_strict(rep, indent=2) if args.json else "\n".join(
@@ -221,7 +240,9 @@ def _cmd_design_h2(args, save_design):
         raise InputError("--objective h2 designs general-form filters only; leave out --form observer")
     if args.points < 2:
         raise InputError(f"--points must be >= 2; got {args.points}")
-    rep, result = mixed_design_report(None, args.delta_bar, gamma=args.gamma, solver=args.solver, points=args.points)
+    with _design_watch(args, 6, 1 if args.gamma is not None else args.points + 1, "common"):  # one design per point
+        rep, result = mixed_design_report(None, args.delta_bar, gamma=args.gamma, solver=args.solver,
+                                          points=args.points)
     if args.save:
         rep["saved_to"] = str(save_design(result, args.save))
     print(dumps_strict(rep, indent=2) if args.json else format_mixed_design_report(rep))
@@ -333,6 +354,9 @@ def _parser():
                         "(constant uncertainty; default for a polytope)")
     d.add_argument("--recertify", metavar="FILE", default=None,
                    help="re-check a saved design file in float64 without a solver (LMI witness and sampled norms)")
+    d.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="refuse a design whose estimated time exceeds SECONDS (default 3600; the estimate and a "
+                        "progress bar are shown for designs above a few seconds)")
     d.add_argument("--json", action="store_true", help="print one JSON object")
     d.set_defaults(func=_cmd_design)
 

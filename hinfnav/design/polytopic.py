@@ -40,6 +40,7 @@ from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
 from ..lmi.polytopic import extended_h2_matrices, extended_hinf_positive, hinf_gamma_index, polytopic_problem
+from ..lmi.conditioning import pow2
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
@@ -112,9 +113,13 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
         if P.shape != (Abar.shape[0],) * 2 or G.shape != P.shape:
             raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the error system "
                              f"has {Abar.shape[0]} states")
-        N0 = extended_hinf_positive(P, G @ Abar, G @ Bbar, Cbar, G, 0.0)
+        # noise far from unit scale: (E1) is tested as T N T, T = diag(I, I, I/r, I) with r a power of two (exact in
+        # floating point), at level γ/r: the same inequality, with the eigenvalue tolerance at the unit scale
+        s = float(np.linalg.norm(Bbar, 2))
+        r = pow2(s) if s > 0 and np.isfinite(s) and not NOISE_WINDOW[0] <= s <= NOISE_WINDOW[1] else 1.0
+        N0 = extended_hinf_positive(P, G @ Abar, G @ (Bbar / r), Cbar, G, 0.0)
         g, _ = schur_gamma(-N0, hinf_gamma_index(Abar.shape[0], Bbar.shape[1]))
-        per.append(g)
+        per.append(g * r)
     return max(per), per
 
 
@@ -248,7 +253,16 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     if form == "general" and objective == "hinf" and system.cells:
         return _cells_result(system, lyapunov, solvers, t0)
     verts = _vertex_tuples(system)
+    rho = _noise_normalisation(verts) if objective == "hinf" else 1.0
+    if rho != 1.0:  # (E1) with B̄/ρ at level γ²/ρ² is a congruence of (E1): same witness, γ × ρ (issue 36)
+        verts = [(A, B / rho, C, D / rho, L) for A, B, C, D, L in verts]
     problem = polytopic_problem(verts, form, lyapunov, objective=objective)  # built once, re-solved below
+
+    def solve(slv, level):
+        if rho == 1.0:
+            return problem.solve(slv, level)
+        sol = problem.solve(slv, level if level is None or isinstance(level, str) else level / rho**2)
+        return dataclasses.replace(sol, gamma2=sol.gamma2 * rho**2)
 
     def certify(_, sol):
         out = _rebuild_and_certify(system, sol.as_dict(), form, alphas, objective)
@@ -256,7 +270,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
-    run = solve_and_certify([("as given", problem.solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
+    run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
                             steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
     log, seconds = run.log, run.seconds
     statuses = [f"{slv} {st}" for slv, st in run.statuses]
@@ -286,6 +300,27 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         solve_time_s=seconds, total_time_s=time.perf_counter() - t0, dt=system.dt, attempts=tuple(log),
         system=system, objective=objective, solver_calls=run.calls,
     )
+
+
+#: Noise scales (max ‖B‖₂, ‖D‖₂ over the vertices) outside this window are normalised to 1 before solving.
+NOISE_WINDOW = (1e-2, 1e2)
+
+
+def _noise_normalisation(verts):
+    """ρ dividing B and D of every vertex before the solve (internal; issue 36: γ scales with the noise).
+
+    1 (nothing done, so existing designs are unchanged to the bit) when the
+    noise scale ``s = max_i max(‖Bᵢ‖₂, ‖Dᵢ‖₂)`` is inside
+    :data:`NOISE_WINDOW`; otherwise ``s``: the solvers fail on (E1) with
+    noise of 1e-7 (double integrator, B, D × 1e-6: "optimal_inaccurate",
+    nothing certified) or 1e5 ("infeasible"). (E1) of ``(B/ρ, D/ρ)`` at
+    ``γ²/ρ²`` is ``T N T`` with ``T = diag(I, I, I/ρ, I)``: the same
+    witness certifies γ for the original data.
+    """
+    s = max(max(np.linalg.norm(B, 2), np.linalg.norm(D, 2)) for _, B, _, D, _ in verts)
+    if not (s > 0 and np.isfinite(s)) or NOISE_WINDOW[0] <= s <= NOISE_WINDOW[1]:
+        return 1.0
+    return float(s)
 
 
 def _augmented_result(system, lyapunov, solvers, alphas, t0):

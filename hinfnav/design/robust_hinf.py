@@ -391,7 +391,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     state_scaling = options.state_scaling if isinstance(options.state_scaling, str) else np.array(options.state_scaling)
     if "SCS" in solvers:
         warnings.warn(_SCS_WARNING, SolverAccuracyWarning, stacklevel=2)
-    P = normalize(prepare(system, structure, state_scaling, form), options.normalize_above)
+    P = normalize(prepare(system, structure, state_scaling, form, normalize_noise=True), options.normalize_above)
     other = "units" if isinstance(state_scaling, str) and state_scaling == "balance" else "balance"
     preps = [P]
     for Q in (normalize(P, 0.0), normalize(prepare(system, structure, other, form), 0.0)):

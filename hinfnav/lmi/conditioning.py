@@ -40,6 +40,8 @@ __all__ = [
     "NORMALIZE_THRESHOLD",
     "block_scales",
     "normalize",
+    "noise_scale",
+    "solver_data",
     "lmi20_diagonal",
 ]
 
@@ -66,6 +68,7 @@ class Prepared:
     form: str = "general"  # "observer": Ā_F = S A + B̄_F C and C̄_F = −L (scaled data) are substituted
     rho: float = 1.0  # B, D above are the state-scaled ones divided by rho (a power of two), see normalize()
     nu: float = 1.0  # L above is the state-scaled one divided by nu (a power of two)
+    noise_ref: float = 0.0  # > 0: normalize() divides B, D by exactly this (noise_scale(), a real factor), 0: off
 
     @property
     def normalized(self) -> bool:
@@ -201,7 +204,29 @@ def unit_scaling(A: ArrayLike, inputs: ArrayLike, outputs: ArrayLike, sweeps: in
     return sig
 
 
-def prepare(system: UncertainSystem, structure: str, scaling: str | ArrayLike, form: str = "general") -> Prepared:
+def noise_scale(system: UncertainSystem) -> float:
+    """Scale of the noise inputs that scales with them and does not depend on the state units (internal).
+
+    ``ρ₀ = max(‖D‖₂, ‖[C; L] Aʲ B‖₂)`` with j the first power (0 … n−1)
+    at which the Markov parameter is nonzero: with ``x = diag(d) x'`` the
+    products ``[C; L] Aʲ B`` are unchanged, and with B, D × k they are
+    multiplied by k, so ``ρ₀`` is multiplied by k exactly (to rounding).
+    1.0 when B and D reach no output (nothing to normalise).
+    """
+    rho = float(np.linalg.norm(system.D, 2)) if system.D.size else 0.0
+    out = np.vstack([system.C, system.L])
+    M = np.asarray(system.B, dtype=float)
+    for _ in range(system.A.shape[0]):
+        markov = float(np.linalg.norm(out @ M, 2))
+        if markov > 0:
+            rho = max(rho, markov)
+            break
+        M = system.A @ M
+    return rho if rho > 0 and math.isfinite(rho) else 1.0
+
+
+def prepare(system: UncertainSystem, structure: str, scaling: str | ArrayLike, form: str = "general",
+            normalize_noise: bool = False) -> Prepared:
     """Drop, balance and scale the data of one synthesis (see the module docstring).
 
     ``scaling="units"``: first the unit-free scaling :func:`unit_scaling`
@@ -214,10 +239,22 @@ def prepare(system: UncertainSystem, structure: str, scaling: str | ArrayLike, f
     eigenvalue test's margin). ``"balance"`` (the default of
     :class:`~hinfnav.lmi.SolverOptions`, kept because the papers'
     published designs depend on it): the power-of-two balancing of A alone.
+
+    ``normalize_noise=True`` (with ``"units"``; the path of ``design
+    --system``): the noise inputs are measured by :func:`noise_scale` (ρ₀,
+    invariant to the state units, proportional to B and D), the unit-free
+    scaling is computed on the data with B / ρ₀, and :func:`normalize`
+    divides B and D by exactly ρ₀: the solver sees the same problem (to
+    rounding) whatever the noise scale, and γ comes back × ρ₀ (issue 36:
+    γ scales with B, D × k to ~1e-9 relative for k = 1e-6 … 1e6, where the
+    power-of-two normalisation above a threshold left 4e-5). Not used by the
+    papers' designs (``"balance"``), which stay bitwise unchanged.
     """
     H_b = E_b = None
+    rho0 = noise_scale(system) if normalize_noise and isinstance(scaling, str) and scaling == "units" else 0.0
     if isinstance(scaling, str) and scaling == "units":
-        ins = system.B if system.H is None else np.hstack([system.B, system.H])
+        B_in = system.B / rho0 if rho0 > 0 else system.B
+        ins = B_in if system.H is None else np.hstack([B_in, system.H])
         outs = np.vstack([system.C, system.L] + ([] if system.E is None else [system.E]))
         s0 = unit_scaling(system.A, ins, outs)
         sigma = s0 * state_scaling(system.A * s0[None, :] / s0[:, None], "balance")
@@ -240,7 +277,7 @@ def prepare(system: UncertainSystem, structure: str, scaling: str | ArrayLike, f
     if H_b is not None:
         H = Si[:, None] * H_b
         E = E_b * sigma[None, :]
-    return Prepared(A, B, C, system.D, L, H, E, sigma, H_b, E_b, form)
+    return Prepared(A, B, C, system.D, L, H, E, sigma, H_b, E_b, form, noise_ref=rho0)
 
 
 
@@ -313,11 +350,43 @@ def normalize(P, threshold=NORMALIZE_THRESHOLD):
     """
     P = P.unnormalized()
     scales = block_scales(P)
-    rho = pow2(scales["inputs"]) if scales["inputs"] > threshold and scales["inputs"] > 0 else 1.0
+    if P.noise_ref > 0:  # prepare(normalize_noise=True): always, by the exact real factor (see there)
+        rho = P.noise_ref
+    else:
+        rho = pow2(scales["inputs"]) if scales["inputs"] > threshold and scales["inputs"] > 0 else 1.0
     nu = pow2(scales["output"]) if scales["output"] > threshold and scales["output"] > 0 else 1.0
     if rho == 1.0 and nu == 1.0:
         return P
     return dataclasses.replace(P, B=P.B / rho, D=P.D / rho, L=P.L / nu, rho=rho, nu=nu)
+
+
+#: Mantissa bits kept by :func:`solver_data` (relative rounding 2⁻³³ ≈ 1.2e-10).
+SOLVER_DATA_BITS = 32
+
+
+def solver_data(P: Prepared) -> Prepared:
+    """The data handed to the solver: ``P`` itself, or with ``noise_ref`` set, ``P`` rounded to 32 mantissa bits.
+
+    The unit-free, noise-normalised data of the same plant written in other
+    state units or with B, D × k agree to a few ulps only (real scale
+    factors), and the interior-point solvers amplify an ulp into 1e-5 of
+    certified γ (measured on Sun et al. (2011)'s chaser: Clarabel
+    "optimal" against "optimal_inaccurate", γ 0.3587428 against
+    0.3587239). Rounded to :data:`SOLVER_DATA_BITS` bits, such data are
+    bitwise the same, so the solver answers the same. Only the solver sees
+    the rounded data (a relative change ≤ 1.2e-10 of each entry); the
+    certificate is evaluated on ``P`` unrounded and on the original system.
+    """
+    if not P.noise_ref > 0:
+        return P
+
+    def rnd(M):
+        if M is None:
+            return None
+        m, e = np.frexp(np.asarray(M, dtype=float))
+        return np.ldexp(np.round(m * 2.0**SOLVER_DATA_BITS) / 2.0**SOLVER_DATA_BITS, e)
+
+    return dataclasses.replace(P, A=rnd(P.A), B=rnd(P.B), C=rnd(P.C), D=rnd(P.D), L=rnd(P.L), H=rnd(P.H), E=rnd(P.E))
 
 
 def lmi20_diagonal(P):

@@ -7,6 +7,8 @@ state scaling) in one object, in the manner of dkpy's synthesis strategies.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import math
 import numbers
@@ -14,6 +16,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Iterator
 
 import cvxpy as cp
 import numpy as np
@@ -21,7 +24,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
-from .conditioning import NORMALIZE_THRESHOLD
+from .conditioning import NORMALIZE_THRESHOLD, solver_data
 from .forksafety import note_solve
 
 if TYPE_CHECKING:
@@ -31,7 +34,8 @@ if TYPE_CHECKING:
     from .conditioning import Prepared
 
 __all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
-           "run_solver", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi", "BLOCK_RETRY"]
+           "run_solver", "watch_solves", "SolveWatch", "SCS_BUDGET_S", "solve_once", "solve_once_gamma", "lmi20_problem",
+           "solve_lmi", "BLOCK_RETRY"]
 
 #: Solvers the synthesis accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")
@@ -224,6 +228,90 @@ def solver_kwargs(solver, accuracy):
     return {}
 
 
+#: Seconds of SCS solver time a design watched by :func:`watch_solves` may spend in all (issue 36: ``design
+#: --system examples/two_mass_spring_30pct.toml --form observer --solver SCS`` made SCS solves for 181 s wall; with
+#: this budget the design returns the best point certified within it, or says the budget ran out).
+SCS_BUDGET_S = 60.0
+
+
+@dataclass
+class SolveWatch:
+    """What :func:`watch_solves` watches: per-solver time budgets, time spent, calls, and a callback.
+
+    Attributes
+    ----------
+    budget : dict
+        Seconds of solver time allowed per solver name (a solver not named
+        has no budget).
+    spent : dict
+        Seconds spent so far per solver.
+    calls : int
+        Solver invocations so far (all solvers).
+    on_call : callable or None
+        ``on_call(watch, solver, status, seconds)`` after each invocation
+        (a progress bar).
+    """
+
+    budget: dict = field(default_factory=dict)
+    spent: dict = field(default_factory=dict)
+    calls: int = 0
+    on_call: Callable | None = None
+    exhausted: list = field(default_factory=list)
+
+    def remaining(self, solver: str) -> float:
+        """Seconds left for ``solver`` (inf: no budget)."""
+        if solver not in self.budget:
+            return math.inf
+        return self.budget[solver] - self.spent.get(solver, 0.0)
+
+
+_WATCH: contextvars.ContextVar = contextvars.ContextVar("hinfnav_solve_watch", default=None)
+
+
+@contextlib.contextmanager
+def watch_solves(budget: dict | None = None, on_call: Callable | None = None) -> Iterator[SolveWatch]:
+    """Context manager: every :func:`run_solver` call inside is counted, timed and held to a time budget.
+
+    ``budget={"SCS": 60}``: SCS's ``time_limit_secs`` of each solve is at
+    most what is left of the budget, and once it is used up SCS is not
+    called again (the solve reports ``"solver error (the SCS time budget
+    ... is used up)"``, the design loop goes on with what it has: the best
+    certified point, or a :class:`~hinfnav.core.exceptions.CertificationError`
+    naming the budget). The command line's ``design`` runs inside one with
+    :data:`SCS_BUDGET_S`.
+    """
+    watch = SolveWatch(dict(budget or {}), {}, 0, on_call)
+    token = _WATCH.set(watch)
+    try:
+        yield watch
+    finally:
+        _WATCH.reset(token)
+
+
+#: SCS's status value for a solve stopped by Ctrl-C (SCS_SIGINT in SCS's glbopts.h; cvxpy maps it to a solver error).
+SCS_SIGINT = -5
+
+
+@contextlib.contextmanager
+def _scs_interrupts() -> Iterator[None]:
+    """While inside, an SCS solve that SCS stopped on Ctrl-C raises KeyboardInterrupt (cvxpy calls ``scs.solve``)."""
+    import scs
+
+    original = scs.solve
+
+    def solve(*args: Any, **kwargs: Any) -> Any:
+        out = original(*args, **kwargs)
+        if out.get("info", {}).get("status_val") == SCS_SIGINT:
+            raise KeyboardInterrupt
+        return out
+
+    scs.solve = solve
+    try:
+        yield
+    finally:
+        scs.solve = original
+
+
 #: Exceptions a cvxpy solve may raise on a hard LMI (CVXOPT raises ArithmeticError from inside LAPACK).
 SOLVER_ERRORS = (cp.error.SolverError, ArithmeticError, ValueError, np.linalg.LinAlgError)
 
@@ -245,21 +333,48 @@ def run_solver(prob: cp.Problem, solver: str, accuracy: float | None = None, ret
         cvxpy's status, or ``"solver error (...)"``.
     seconds : float
     calls : int
-        Solver invocations (1 or 2).
+        Solver invocations (1 + the number of retries used).
     """
+    watch = _WATCH.get()
     start = time.perf_counter()
     factors = (100.0,) if retry is True else tuple(retry or ())
     tries = (None,) if accuracy is None else (accuracy,) + tuple(f * accuracy for f in factors)
-    error = None
+    status, calls = None, 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for calls, acc in enumerate(tries, start=1):
+        for acc in tries:
+            kwargs = {} if acc is None else solver_kwargs(solver, acc)
+            if watch is not None and solver in watch.budget:
+                left = watch.remaining(solver)
+                if left <= 0.5:
+                    watch.exhausted.append(solver)
+                    status = (f"solver error (the {solver} time budget of {watch.budget[solver]:g} s for this design is "
+                              "used up)")
+                    break
+                if solver == "SCS":
+                    kwargs["time_limit_secs"] = min(kwargs.get("time_limit_secs", SCS_TIME_LIMIT_S), left)
+            calls += 1
+            t0 = time.perf_counter()
+            # SCS catches Ctrl-C itself (its own SIGINT handler during a solve) and reports a solver error, so a
+            # design would go on to its next solve: its "interrupted" status is turned back into KeyboardInterrupt
+            # (issue 36), which stops the command as anywhere else
+            hold = _scs_interrupts() if solver == "SCS" else contextlib.nullcontext()
             try:
-                prob.solve(solver=solver, **({} if acc is None else solver_kwargs(solver, acc)))
-                return str(prob.status), time.perf_counter() - start, calls
+                with hold:
+                    prob.solve(solver=solver, **kwargs)
+                status = str(prob.status)
             except SOLVER_ERRORS as exc:
-                error = exc
-    return f"solver error ({error})", time.perf_counter() - start, len(tries)
+                status = f"solver error ({exc})"
+            finally:
+                if watch is not None:
+                    watch.spent[solver] = watch.spent.get(solver, 0.0) + time.perf_counter() - t0
+                    watch.calls += 1
+            if not status.startswith("solver error"):
+                break
+    seconds = time.perf_counter() - start
+    if watch is not None and watch.on_call is not None:
+        watch.on_call(watch, solver, status, seconds)
+    return status, seconds, calls
 
 
 def solve_once(cons: list, level: Any, solver: str, accuracy: float | None, t: Any = None,
@@ -420,6 +535,7 @@ def lmi20_problem(P: Prepared, margin: float = 1e-8, accuracy: float = 1e-8, bou
     tolerances of :data:`BLOCK_RETRY`. Signals outside every block get zero filter gains (B̄_F
     columns, C̄_F rows), which the averaging argument shows is optimal.
     """
+    P = solver_data(P)  # rounded to 32 bits on the unit-free, noise-normalised path (see there)
     n, p = P.B.shape
     q = P.D.shape[1]
     observer = P.form == "observer"
