@@ -63,6 +63,7 @@ from ..core.validation import as_choice
 from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
 from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
+from .compiled_nonlinear import model_status, run_model_kernel, uses_model_route
 
 __all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
            "run_compiled", "select_backend", "use_backend", "why_numpy"]
@@ -157,8 +158,10 @@ def kernel_status(est: Any) -> str | None:
                                       or getattr(est.measurement, "H", None) is None):
             return "missing='skip' replaces a missing reading by h(x̂): on the compiled path for a linear h only"
         return None
+    if uses_model_route(est, kind):  # a nonlinear model or missing="skip": the kernels on the model's functions
+        return model_status(est, kind)
     if est.missing != "refuse":
-        return "missing='skip' runs on the NumPy path only (except for the LTI filter)"
+        return "missing='skip' runs on the NumPy path only (except for the LTI filter, the EKF and the sigma-point filter)"
     system = est.system
     if not isinstance(system, LinearSystem) or type(system).propagate is not LinearSystem.propagate:
         return "its system is not a hinfnav LinearSystem"
@@ -243,8 +246,10 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     when the covariance is shared by every run (as on the NumPy path of the Kalman filters; the sigma-point
     filter's NumPy path returns a copy per run).
     """
-    kern = _kernels()
     kind = _kind(est)
+    if uses_model_route(est, kind):
+        return run_model_kernel(est, kind, y, u, xhat0, P0, keep_covariance, diagnostics)
+    kern = _kernels()
     runs, steps, _ = y.shape
     if kind == "lti":
         xhat = np.empty((runs, steps, est.n_state))
