@@ -79,7 +79,7 @@ def model_status(est: Any, kind: str) -> str | None:
     if kind == "kalman" and (getattr(est, "strong_tracking", False) or getattr(est, "huber_correction", False)
                              or getattr(est, "defers_prior", False)):
         return ("strong tracking and Huber's correction run compiled on a linear model only (a LinearSystem, "
-                "y = H x + D v, missing='refuse')")
+                "y = H x + D v) and without missing='skip'")
     if kind == "sigma_point" and est.error_coordinates:
         return "its state has its own error coordinates (a quaternion)"
     if getattr(est, "R_of_reading", None) is not None or getattr(est, "R", None) is None or np.ndim(est.R) != 2:
