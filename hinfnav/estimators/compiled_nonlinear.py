@@ -189,4 +189,10 @@ def run_model_kernel(est: Any, kind: str, y: np.ndarray, u: np.ndarray, xhat0: n
     if not ok:
         return None, None, {}
     out = {"innovation": nu_hist, "innovation_covariance": S_hist}
-    return xhat, {0: None, 1: Pdiag, 2: Pfull}[keep], {k: v for k, v in out.items() if k in keys}
+    P_hist = {0: None, 1: Pdiag, 2: Pfull}[keep]
+    if P_hist is not None and runs > 1 and getattr(est, "shares_covariance", False) and (P_hist == P_hist[:1]).all():
+        # a linear model whose runs lack the same channels: one covariance for every run, as the NumPy path keeps it
+        P_hist = P_hist[0]
+        P_hist.setflags(write=False)
+        P_hist = np.broadcast_to(P_hist, (runs,) + P_hist.shape)
+    return xhat, P_hist, {k: v for k, v in out.items() if k in keys}
