@@ -15,7 +15,12 @@
   does not inherit it) on a linear system with a constant measurement matrix
   (``y = H x + D v``), a constant R, ``missing="refuse"`` and no diagnostics
   requested; for any other estimator or option the request raises an
-  :class:`~hinfnav.core.exceptions.InputError` that says why.
+  :class:`~hinfnav.core.exceptions.InputError` that says why. The EKF and the
+  sigma-point filter also run on a nonlinear model (or with ``missing="skip"``)
+  whose dynamics and measurement declare compiled functions
+  (``compiled_functions()``, :mod:`hinfnav.systems.compiled`): the kernels of
+  :mod:`hinfnav.estimators.compiled_models`, routed by
+  :mod:`hinfnav.estimators.compiled_nonlinear`.
 
 A filter that declares a kernel gives it what it needs through public
 attributes: the model (``F``/``Gamma``/``Q``/``R`` or the augmented ``Phi_a``,
