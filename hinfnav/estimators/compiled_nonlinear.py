@@ -43,6 +43,36 @@ _DYNAMICS_METHODS = ("f", "jacobian", "propagate")
 _MEASUREMENT_METHODS = ("function", "jacobian", "residual")
 _VERIFIED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _MODULE = {}
+_ADDRESSES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _module():
+    """The kernels' module (numba) and its entry points, imported on the first request.
+
+    The kernels are called through their one compiled overload's entry point
+    (their arguments are made C-contiguous float64 arrays here, the functions
+    wrapped by :func:`_address`): numba's dispatcher would otherwise resolve the
+    type of every function argument at each call (about 0.1 ms a call).
+    """
+    if "module" not in _MODULE:
+        kern = importlib.import_module(f"{__package__}.compiled_models")
+        fns = importlib.import_module("hinfnav.systems.compiled_functions")
+        wap = importlib.import_module("numba.core.types.function_type").CompileResultWAP
+        _MODULE.update(module=kern, functions=fns, wap=wap, entry={
+            name: getattr(kern, name).overloads[getattr(kern, name).signatures[0]].entry_point
+            for name in ("ekf_model_batch", "sigma_point_model_batch")})
+    return _MODULE
+
+
+def _address(fn, sig):
+    """``fn`` (a numba dispatcher) compiled for ``sig`` as a first-class function object (numba's
+    ``CompileResultWAP``: the address of its compiled wrapper), once per function and signature."""
+    per_fn = _ADDRESSES.setdefault(fn, {})
+    if sig not in per_fn:
+        if sig.args not in fn.overloads:
+            fn.compile(sig)  # a user's lazily compiled function (numba's own typing error if it does not fit)
+        per_fn[sig] = _module()["wap"](fn.overloads[sig.args])
+    return per_fn[sig]
 
 
 def uses_model_route(est: Any, kind: str | None) -> bool:
@@ -54,7 +84,7 @@ def uses_model_route(est: Any, kind: str | None) -> bool:
     linear_meas = (getattr(meas, "linear", False) and getattr(meas, "H", None) is not None
                    and type(meas).residual is MeasurementModel.residual and not hasattr(meas, "convert"))
     return not (linear_system and linear_meas and est.missing == "refuse"
-                and not (kind == "kalman" and est.nonlinear_dynamics))
+                and not (kind == "kalman" and getattr(est, "nonlinear_dynamics", False)))
 
 
 def _functions(model, what, names):
@@ -156,9 +186,8 @@ def run_model_kernel(est: Any, kind: str, y: np.ndarray, u: np.ndarray, xhat0: n
                      keep_covariance: bool | str, diagnostics: set) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
     """``(xhat, P history, diagnostics)`` of ``est`` on its models' compiled functions, or ``(None, None, {})`` to
     fall back to the NumPy path (arguments as :func:`hinfnav.estimators.compiled.run_compiled`'s)."""
-    if "module" not in _MODULE:
-        _MODULE["module"] = importlib.import_module(f"{__package__}.compiled_models")
-    kern = _MODULE["module"]
+    mod = _module()
+    sigs, entry = mod["functions"], mod["entry"]
     dyn, _ = _functions(est.system, "dynamics model", _DYNAMICS_METHODS)
     meas, _ = _functions(est.measurement, "measurement model", _MEASUREMENT_METHODS)
     runs, steps, m = y.shape
@@ -179,13 +208,18 @@ def run_model_kernel(est: Any, kind: str, y: np.ndarray, u: np.ndarray, xhat0: n
     S_hist = np.empty((runs, steps, m, m)) if diag else np.empty((1, 1, 1, 1))
     y = _float(y)
     common = (_float(est.Q), _float(est.R), P_start, x0, y, uu, float(est.dt), est.output == "filtered")
+    f = _address(dyn.f, sigs.DYNAMICS_SIGNATURE)
+    h = _address(meas.h, sigs.MEASUREMENT_SIGNATURE)
+    res = _address(meas.residual, sigs.RESIDUAL_SIGNATURE)
+    skip = est.missing == "skip"
     if kind == "kalman":
-        ok = kern.ekf_model_batch(dyn.f, dyn.jacobian, meas.h, meas.jacobian, meas.residual, dyn.params, meas.params,
-                                  *common, est.missing == "skip", keep, xhat, Pdiag, Pfull, diag, nu_hist, S_hist)
+        ok = entry["ekf_model_batch"](f, _address(dyn.jacobian, sigs.DYNAMICS_JACOBIAN_SIGNATURE), h,
+                                      _address(meas.jacobian, sigs.MEASUREMENT_JACOBIAN_SIGNATURE), res, dyn.params,
+                                      meas.params, *common, skip, keep, xhat, Pdiag, Pfull, diag, nu_hist, S_hist)
     else:
-        ok = kern.sigma_point_model_batch(dyn.f, meas.h, meas.residual, dyn.params, meas.params, *common,
-                                          _float(est.Wm), _float(est.Wc), float(est.scale), est.rule == "unscented",
-                                          est.missing == "skip", keep, xhat, Pdiag, Pfull, diag, nu_hist, S_hist)
+        ok = entry["sigma_point_model_batch"](f, h, res, dyn.params, meas.params, *common, _float(est.Wm),
+                                              _float(est.Wc), float(est.scale), est.rule == "unscented", skip, keep,
+                                              xhat, Pdiag, Pfull, diag, nu_hist, S_hist)
     if not ok:
         return None, None, {}
     out = {"innovation": nu_hist, "innovation_covariance": S_hist}

@@ -11,9 +11,7 @@ models declare theirs (:class:`~hinfnav.systems.ConstantTurn`,
 :class:`~hinfnav.systems.LinearMeasurement`, and every
 :class:`~hinfnav.systems.LinearSystem`, e.g. Hill's relative motion).
 
-How to write a numba-compilable model
--------------------------------------
-Give your model class (a subclass of
+**How to write a numba-compilable model.** Give your model class (a subclass of
 :class:`~hinfnav.systems.DynamicsModel` or
 :class:`~hinfnav.systems.MeasurementModel`, with its NumPy ``f``/``jacobian``
 or ``function``/``jacobian``, the reference) a method
