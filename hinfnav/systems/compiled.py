@@ -36,6 +36,7 @@ of the estimate being propagated, as the NumPy path passes it.
 Example (a pendulum, θ̈ = −(g/ℓ) sin θ, one explicit Euler step of Δt; ``p = (Δt, g/ℓ)``)::
 
     import numba, numpy as np
+    import hinfnav as hn
     from hinfnav.systems.compiled import CompiledDynamics
 
     @numba.njit(cache=True)
