@@ -72,7 +72,8 @@ def test_constant_turn_ekf_and_sigma_point_compiled_equal_numpy(turn):
     ekf = ExtendedKalmanFilter(model, sensor, P0=P0)
     for est in (ekf, SigmaPointFilter.from_ekf(ekf), SigmaPointFilter.from_ekf(ekf, rule="cubature"),
                 SigmaPointFilter.from_ekf(ekf, alpha=0.5, kappa=1.0),
-                ExtendedKalmanFilter(model, sensor, P0=P0, output="predicted")):
+                ExtendedKalmanFilter(model, sensor, P0=P0, output="predicted"),
+                SigmaPointFilter(model, sensor, P0=P0, output="predicted")):
         ref, got = _both(est, y, u, x0, diagnostics=NIS)
         _assert_same(ref, got, f"{est.name} {getattr(est, 'rule', '')}")
         for keep in (False, "diagonal"):
