@@ -64,15 +64,17 @@ def _module():
     return _MODULE
 
 
-def _address(fn, sig):
-    """``fn`` (a numba dispatcher) compiled for ``sig`` as a first-class function object (numba's
-    ``CompileResultWAP``: the address of its compiled wrapper), once per function and signature."""
+def _address(fn, name):
+    """``fn`` (a numba dispatcher) compiled for the signature ``name`` of :mod:`hinfnav.systems.compiled_functions`
+    as a first-class function object (numba's ``CompileResultWAP``: the address of its compiled wrapper), once per
+    function and signature (keyed by name: hashing numba's signature objects costs more than the call)."""
     per_fn = _ADDRESSES.setdefault(fn, {})
-    if sig not in per_fn:
+    if name not in per_fn:
+        sig = getattr(_module()["functions"], name)
         if sig.args not in fn.overloads:
             fn.compile(sig)  # a user's lazily compiled function (numba's own typing error if it does not fit)
-        per_fn[sig] = _module()["wap"](fn.overloads[sig.args])
-    return per_fn[sig]
+        per_fn[name] = _module()["wap"](fn.overloads[sig.args])
+    return per_fn[name]
 
 
 def uses_model_route(est: Any, kind: str | None) -> bool:
@@ -186,8 +188,7 @@ def run_model_kernel(est: Any, kind: str, y: np.ndarray, u: np.ndarray, xhat0: n
                      keep_covariance: bool | str, diagnostics: set) -> tuple[np.ndarray | None, np.ndarray | None, dict]:
     """``(xhat, P history, diagnostics)`` of ``est`` on its models' compiled functions, or ``(None, None, {})`` to
     fall back to the NumPy path (arguments as :func:`hinfnav.estimators.compiled.run_compiled`'s)."""
-    mod = _module()
-    sigs, entry = mod["functions"], mod["entry"]
+    entry = _module()["entry"]
     dyn, _ = _functions(est.system, "dynamics model", _DYNAMICS_METHODS)
     meas, _ = _functions(est.measurement, "measurement model", _MEASUREMENT_METHODS)
     runs, steps, m = y.shape
@@ -208,13 +209,13 @@ def run_model_kernel(est: Any, kind: str, y: np.ndarray, u: np.ndarray, xhat0: n
     S_hist = np.empty((runs, steps, m, m)) if diag else np.empty((1, 1, 1, 1))
     y = _float(y)
     common = (_float(est.Q), _float(est.R), P_start, x0, y, uu, float(est.dt), est.output == "filtered")
-    f = _address(dyn.f, sigs.DYNAMICS_SIGNATURE)
-    h = _address(meas.h, sigs.MEASUREMENT_SIGNATURE)
-    res = _address(meas.residual, sigs.RESIDUAL_SIGNATURE)
+    f = _address(dyn.f, "DYNAMICS_SIGNATURE")
+    h = _address(meas.h, "MEASUREMENT_SIGNATURE")
+    res = _address(meas.residual, "RESIDUAL_SIGNATURE")
     skip = est.missing == "skip"
     if kind == "kalman":
-        ok = entry["ekf_model_batch"](f, _address(dyn.jacobian, sigs.DYNAMICS_JACOBIAN_SIGNATURE), h,
-                                      _address(meas.jacobian, sigs.MEASUREMENT_JACOBIAN_SIGNATURE), res, dyn.params,
+        ok = entry["ekf_model_batch"](f, _address(dyn.jacobian, "DYNAMICS_JACOBIAN_SIGNATURE"), h,
+                                      _address(meas.jacobian, "MEASUREMENT_JACOBIAN_SIGNATURE"), res, dyn.params,
                                       meas.params, *common, skip, keep, xhat, Pdiag, Pfull, diag, nu_hist, S_hist)
     else:
         ok = entry["sigma_point_model_batch"](f, h, res, dyn.params, meas.params, *common, _float(est.Wm),

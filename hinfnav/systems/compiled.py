@@ -88,6 +88,8 @@ from ..core.exceptions import InputError
 
 __all__ = ["CompiledDynamics", "CompiledMeasurement", "package_functions"]
 
+_FUNCTIONS = {}
+
 
 def _params(value: ArrayLike) -> np.ndarray:
     p = np.array(value, dtype=float, order="C").ravel()
@@ -142,4 +144,6 @@ class CompiledMeasurement:
 def package_functions():
     """The module of the package's own compiled functions (:mod:`hinfnav.systems.compiled_functions`), imported
     (with numba) on the first call."""
-    return importlib.import_module(f"{__package__}.compiled_functions")
+    if "module" not in _FUNCTIONS:
+        _FUNCTIONS["module"] = importlib.import_module(f"{__package__}.compiled_functions")
+    return _FUNCTIONS["module"]
