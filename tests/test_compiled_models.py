@@ -271,7 +271,7 @@ def test_a_singular_point_raises_the_numpy_paths_error(turn):
     assert str(default_error.value) == str(numpy_error.value)
 
 
-def test_grace_two_body_j2_ekf_is_compiled():
+def test_grace_two_body_j2_ekf_compiled_equals_numpy():
     # the GRACE chapter's EKF whose mean goes through the two-body (+ J2) pair model (one RK4 step of both
     # spacecraft from GRACE-B's tabulated state), its covariance through Hill's Φ: its PairPrediction model declares
     # numba functions; 150 epochs of the real data with gaps (missing='skip'), against the NumPy path
@@ -291,7 +291,7 @@ def test_grace_two_body_j2_ekf_is_compiled():
     # at most): the estimates meet 1e-10 relative, the innovations are compared to 4 ulps of |r| (3.7e-9 m)
     ulp = float(np.spacing(np.linalg.norm(data.rB[0])))
     for model in ("two_body_j2", "two_body"):
-        est = grace.NonlinearPredictionEKF(sys_hill, ms.model, chief=(data.rB, data.vB), model=model,
-                                           P0=np.diag(grace.P0_STD**2), Q=Q, missing="skip")
+        est = grace.CompiledNonlinearPredictionEKF(sys_hill, ms.model, chief=(data.rB, data.vB), model=model,
+                                                   P0=np.diag(grace.P0_STD**2), Q=Q, missing="skip")
         _assert_same(*_both(est, y, np.zeros((1, n, est.n_input)), data.truth[0], diagnostics=NIS), model,
                      innovation_atol=4 * ulp)
