@@ -28,6 +28,15 @@ the whole batch:
   this machine's single-core GEMM rate (OpenBLAS, one thread, 512 × 512,
   measured in a subprocess).
 
+A second table times your own nonlinear model, one run: the README's
+constant-turn target with a range/bearing sensor (the package's models, their
+compiled functions declared by the models) and a pendulum written here with
+``numba.njit`` functions as a user would (:mod:`hinfnav.systems.compiled`):
+the EKF and the sigma-point filter by default (``backend="auto"``: the
+kernels of :mod:`hinfnav.estimators.compiled_models`) and on the NumPy path,
+each the median and the least of ``--repeat`` CPU timings, and the largest
+relative difference of the default's estimates to the NumPy path's.
+
 The machine may be shared: every cell is the minimum of ``--repeat`` timings
 of the process's CPU time (the least disturbed one; the wall clock would count
 the waits of a batch for a shared CPU); the load average at the start and the
@@ -43,6 +52,7 @@ import sys
 import tempfile
 import time
 
+import numba
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter as FilterpyEKF
 from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
@@ -187,26 +197,120 @@ def filters(sc):
     }
 
 
-def constant_turn_rows(repeat, steps=2000):
-    """µs per step of the EKF and the sigma-point filter on the README's own-model example (constant turn,
-    range/bearing; one run): the default backend, the NumPy path, and why the default is not compiled."""
-    from hinfnav.estimators import ExtendedKalmanFilter, SigmaPointFilter
-    from hinfnav.estimators.compiled import why_numpy
+def constant_turn_data(steps, runs=1):
+    """The README's own-model example: constant turn (5 states), range/bearing sensor; ``(model, sensor, x0, P0, y,
+    u)`` of ``runs`` runs × ``steps`` steps (a noise-free truth, noisy readings; seed 0)."""
     from hinfnav.systems import ConstantTurn, RangeBearing
 
     model = ConstantTurn(dt=1.0, sigma_accel=0.05, sigma_turn_rate=1e-3)
     sensor = RangeBearing(model.n, sigma_range=5.0, sigma_bearing=0.01)
     x0, P0 = np.array([-1500.0, 400.0, 0.0, -15.0, 0.03]), np.diag([50, 50, 5, 5, 0.02]) ** 2.0
+    x = [np.broadcast_to(x0, (runs, 5))]
+    for _ in range(steps - 1):
+        x.append(model.f(x[-1]))
+    y = sensor.measure(np.stack(x, 1), np.random.default_rng(0).standard_normal((runs, steps, 2)))
+    return model, sensor, x0, P0, y, np.zeros((runs, steps, 0))
+
+
+# -- a model of one's own, written with numba (hinfnav.systems.compiled): a pendulum, its bob's position measured --
+
+@numba.njit(cache=True)
+def _pendulum_f(x, u, t, p):  # one explicit Euler step of θ̈ = −(g/ℓ) sin θ; p = (Δt, g/ℓ)
+    out = np.empty(2)
+    out[0] = x[0] + p[0] * x[1]
+    out[1] = x[1] - p[0] * p[1] * np.sin(x[0])
+    return out
+
+
+@numba.njit(cache=True)
+def _pendulum_jacobian(x, u, t, p):
+    J = np.empty((2, 2))
+    J[0, 0], J[0, 1], J[1, 0], J[1, 1] = 1.0, p[0], -p[0] * p[1] * np.cos(x[0]), 1.0
+    return J
+
+
+@numba.njit(cache=True)
+def _bob_h(x, p):  # (ℓ sin θ, −ℓ cos θ); p = (ℓ,)
+    out = np.empty(2)
+    out[0], out[1] = p[0] * np.sin(x[0]), -p[0] * np.cos(x[0])
+    return out
+
+
+@numba.njit(cache=True)
+def _bob_jacobian(x, p):
+    H = np.zeros((2, 2))
+    H[0, 0], H[1, 0] = p[0] * np.cos(x[0]), p[0] * np.sin(x[0])
+    return H
+
+
+def pendulum_data(steps):
+    """A user's pendulum (DynamicsModel and MeasurementModel subclasses declaring numba functions) and one run."""
+    from hinfnav.systems import DynamicsModel, MeasurementModel, StateSpec
+    from hinfnav.systems.compiled import CompiledDynamics, CompiledMeasurement
+
+    class Pendulum(DynamicsModel):
+        def f(self, x, u=None, t=0.0):
+            return np.stack([x[:, 0] + self.dt * x[:, 1], x[:, 1] - self.dt * 4.905 * np.sin(x[:, 0])], axis=-1)
+
+        def jacobian(self, x, u=None, t=0.0):
+            J = np.zeros((x.shape[0], 2, 2))
+            J[:, 0, 0], J[:, 0, 1], J[:, 1, 1] = 1.0, self.dt, 1.0
+            J[:, 1, 0] = -self.dt * 4.905 * np.cos(x[:, 0])
+            return J
+
+        def compiled_functions(self):
+            return CompiledDynamics(_pendulum_f, _pendulum_jacobian, [self.dt, 4.905])
+
+    class Bob(MeasurementModel):
+        def function(self, x):
+            return np.stack([2.0 * np.sin(x[..., 0]), -2.0 * np.cos(x[..., 0])], axis=-1)
+
+        def jacobian(self, x):
+            H = np.zeros(np.shape(x)[:-1] + (2, 2))
+            H[..., 0, 0], H[..., 1, 0] = 2.0 * np.cos(x[..., 0]), 2.0 * np.sin(x[..., 0])
+            return H
+
+        def compiled_functions(self):
+            return CompiledMeasurement(_bob_h, _bob_jacobian, None, [2.0])
+
+    model = Pendulum(StateSpec(("theta", "omega"), ("rad", "rad/s")), 0.01, np.diag([0.0, 1e-6]))
+    sensor = Bob(2, 0.02 * np.eye(2), ("x", "z"), ("m", "m"))
+    x0 = np.array([1.0, 0.0])
     x = [x0[None]]
     for _ in range(steps - 1):
         x.append(model.f(x[-1]))
     y = sensor.measure(np.stack(x, 1), np.random.default_rng(0).standard_normal((1, steps, 2)))
-    u = np.zeros((1, steps, 0))
+    return model, sensor, x0, np.diag([0.1, 0.1]), y, np.zeros((1, steps, 0))
+
+
+def _med_time(fn, repeat):
+    """Median and least of ``repeat`` CPU-time timings of ``fn()``, and its last result."""
+    times = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = fn()
+        times.append(time.process_time() - t0)
+    return float(np.median(times)), float(min(times)), out
+
+
+def own_model_rows(repeat, steps=2000):
+    """µs per step (median and least of ``repeat`` CPU timings) of the EKF and the sigma-point filter on the README's
+    own-model example (constant turn, range/bearing) and on a user's numba pendulum, one run: the default backend,
+    the NumPy path, the largest relative difference of the estimates, and the backend the default ran."""
+    from hinfnav.estimators import ExtendedKalmanFilter, SigmaPointFilter
+    from hinfnav.estimators.compiled import why_numpy
+
     rows = []
-    for est in (ExtendedKalmanFilter(model, sensor, P0=P0), SigmaPointFilter(model, sensor, P0=P0)):
-        t_def, _ = _min_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False), repeat)
-        t_np, _ = _min_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False, backend="numpy"), repeat)
-        rows.append((type(est).__name__, t_def * 1e6 / steps, t_np * 1e6 / steps, why_numpy(est) or "compiled"))
+    for label, data in (("constant turn + range/bearing", constant_turn_data(steps)),
+                        ("user's numba pendulum", pendulum_data(steps))):
+        model, sensor, x0, P0, y, u = data
+        for est in (ExtendedKalmanFilter(model, sensor, P0=P0), SigmaPointFilter(model, sensor, P0=P0)):
+            est.estimate(y[:, :2], u[:, :2], x0)  # the first call: the model's functions compiled or loaded
+            med_d, min_d, got = _med_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False).xhat, repeat)
+            med_n, _, ref = _med_time(lambda est=est: est.estimate(y, u, x0, keep_covariance=False,
+                                                                    backend="numpy").xhat, max(1, repeat // 2))
+            rows.append((label, type(est).__name__, med_d * 1e6 / steps, min_d * 1e6 / steps, med_n * 1e6 / steps,
+                         _rel(ref, got), "numba" if why_numpy(est) is None else f"NumPy: {why_numpy(est)}"))
     return rows
 
 
@@ -301,11 +405,14 @@ def main(argv=None):
             work = flops(kind) * runs + (flops(shared) if shared else 0)
             cells += [f"{work / rate * 1e6:.3f}", f"{_rel(ref, got):.0e}", d_fp]
             print(f"| {name} | {runs} × {steps} | " + " | ".join(cells) + " |", flush=True)
-    print("\nYour own nonlinear model (the README's constant-turn target, range/bearing sensor; 1 run x 2000 steps):")
-    print("| filter | default µs/step | NumPy µs/step | default backend |")
-    print("|---|---:|---:|---|")
-    for name, t_def, t_np, why in constant_turn_rows(args.repeat, 200 if args.quick else 2000):
-        print(f"| {name} | {t_def:.1f} | {t_np:.1f} | {why} |", flush=True)
+    own_steps = 200 if args.quick else 2000
+    print(f"\nYour own nonlinear model (1 run × {own_steps} steps; the median and the least of {args.repeat} CPU "
+          "timings):")
+    print("| model | filter | default µs/step (median) | default µs/step (least) | NumPy µs/step (median) | "
+          "default Δ | default backend |")
+    print("|---|---|---:|---:|---:|---:|---|")
+    for label, name, med_d, min_d, med_n, diff, how in own_model_rows(args.repeat, own_steps):
+        print(f"| {label} | {name} | {med_d:.2f} | {min_d:.2f} | {med_n:.1f} | {diff:.0e} | {how} |", flush=True)
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end; each cell the least of {args.repeat} CPU-time "
           "timings of the whole batch divided by its steps (filterpy: of fewer, on at most 20 runs, scaled to the "
           "runs); Δ: largest |x̂ − x̂_NumPy| over runs and steps, each state channel over its largest |x̂_NumPy|")

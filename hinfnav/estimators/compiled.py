@@ -15,7 +15,12 @@
   does not inherit it) on a linear system with a constant measurement matrix
   (``y = H x + D v``), a constant R, ``missing="refuse"`` and no diagnostics
   requested; for any other estimator or option the request raises an
-  :class:`~hinfnav.core.exceptions.InputError` that says why.
+  :class:`~hinfnav.core.exceptions.InputError` that says why. The EKF and the
+  sigma-point filter also run on a nonlinear model (or with ``missing="skip"``)
+  whose dynamics and measurement declare compiled functions
+  (``compiled_functions()``, :mod:`hinfnav.systems.compiled`): the kernels of
+  :mod:`hinfnav.estimators.compiled_models`, routed by
+  :mod:`hinfnav.estimators.compiled_nonlinear`.
 
 A filter that declares a kernel gives it what it needs through public
 attributes: the model (``F``/``Gamma``/``Q``/``R`` or the augmented ``Phi_a``,
@@ -63,6 +68,7 @@ from ..core.validation import as_choice
 from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
 from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
+from .compiled_nonlinear import model_status, run_model_kernel, uses_model_route
 
 __all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
            "run_compiled", "select_backend", "use_backend", "why_numpy"]
@@ -161,8 +167,10 @@ def kernel_status(est: Any) -> str | None:
                                       or getattr(est.measurement, "H", None) is None):
             return "missing='skip' replaces a missing reading by h(x̂): on the compiled path for a linear h only"
         return None
+    if uses_model_route(est, kind):  # a nonlinear model or missing="skip": the kernels on the model's functions
+        return model_status(est, kind)
     if est.missing != "refuse":
-        return "missing='skip' runs on the NumPy path only (except for the LTI filter)"
+        return "missing='skip' runs on the NumPy path only (except for the LTI filter, the EKF and the sigma-point filter)"
     system = est.system
     if not isinstance(system, LinearSystem) or type(system).propagate is not LinearSystem.propagate:
         return "its system is not a hinfnav LinearSystem"
@@ -247,8 +255,10 @@ def run_compiled(est: Any, y: np.ndarray, u: np.ndarray, xhat0: np.ndarray, P0: 
     when the covariance is shared by every run (as on the NumPy path of the Kalman filters; the sigma-point
     filter's NumPy path returns a copy per run).
     """
-    kern = _kernels()
     kind = _kind(est)
+    if uses_model_route(est, kind):
+        return run_model_kernel(est, kind, y, u, xhat0, P0, keep_covariance, diagnostics)
+    kern = _kernels()
     runs, steps, _ = y.shape
     if kind == "lti":
         xhat = np.empty((runs, steps, est.n_state))

@@ -40,6 +40,7 @@ from ..core.exceptions import InputError
 from ..core.linalg import as_covariance
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
 from .checks import JACOBIAN_TOL, CheckedModel, call_model, check_jacobian_against_differences
+from .compiled import CompiledDynamics, package_functions
 from .state import StateSpec
 
 __all__ = [
@@ -229,6 +230,14 @@ class DynamicsModel(CheckedModel):
         """``∂f/∂x`` at a batch of states, shape (runs, n, n): central differences by default."""
         x, u, t = self.check(x, u, t)
         return finite_difference_jacobian(self.f, x, u, t)
+
+    def compiled_functions(self) -> CompiledDynamics | None:
+        """numba-compiled ``f`` and ``jacobian`` of one state for the compiled filters (None here: the NumPy path).
+
+        A subclass returns a :class:`~hinfnav.systems.compiled.CompiledDynamics`;
+        see :mod:`hinfnav.systems.compiled` for how to write one.
+        """
+        return None
 
     def propagate(self, x: ArrayLike, u: ArrayLike | None = None, w: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """One step of the truth: ``f(x, u, t) + w`` (w (runs, n) a draw of the process noise, or None)."""
@@ -480,3 +489,8 @@ class ConstantTurn(DynamicsModel):
         J[:, 2, 2], J[:, 2, 3], J[:, 2, 4] = cw, -sw, -T * (sw * vx + cw * vy)
         J[:, 3, 2], J[:, 3, 3], J[:, 3, 4] = sw, cw, T * (cw * vx - sw * vy)
         return J
+
+    def compiled_functions(self) -> CompiledDynamics:
+        """(CT1) and its Jacobian for one state, numba-compiled (:mod:`hinfnav.systems.compiled_functions`)."""
+        fns = package_functions()
+        return CompiledDynamics(fns.constant_turn_f, fns.constant_turn_jacobian, [self.dt])

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_matrix, as_positive
+from .compiled import CompiledDynamics, package_functions
 from .state import StateSpec
 
 __all__ = ["LinearSystem"]
@@ -110,6 +111,13 @@ class LinearSystem:
     def jacobian(self, x: ArrayLike | None = None, u: ArrayLike | None = None, t: float = 0.0) -> NDArray[np.float64]:
         """The dynamics-model protocol: ``∂f/∂x = Φ``, shape (n, n), whatever x."""
         return self.Phi
+
+    def compiled_functions(self) -> CompiledDynamics:
+        """``Φ x + Γ u`` and Φ for one state, numba-compiled (:mod:`hinfnav.systems.compiled`), for a filter whose
+        measurement is not linear."""
+        fns = package_functions()
+        params = np.concatenate([[self.n, self.n_input], self.Phi.ravel(), self.Gamma.ravel()])
+        return CompiledDynamics(fns.linear_f, fns.linear_jacobian, params)
 
     def propagate(self, x: ArrayLike, u: ArrayLike | None = None, w: ArrayLike | None = None) -> NDArray[np.float64]:
         """One step for a batch: ``x Φᵀ + u Γᵀ + w Bᵀ`` (rows are runs)."""

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_positive
 from .checks import CheckedModel, call_model, check_jacobian_against_differences
+from .compiled import CompiledMeasurement, package_functions
 from .dynamics import finite_difference_jacobian
 
 __all__ = [
@@ -134,6 +135,12 @@ class MeasurementModel(CheckedModel):
         """``y − ŷ`` (angles wrapped where a model has them)."""
         return np.asarray(y) - np.asarray(yhat)
 
+    def compiled_functions(self) -> CompiledMeasurement | None:
+        """numba-compiled ``h``, ``jacobian`` and ``residual`` of one state for the compiled filters (None here: the
+        NumPy path). A subclass returns a :class:`~hinfnav.systems.compiled.CompiledMeasurement`; see
+        :mod:`hinfnav.systems.compiled` for how to write one."""
+        return None
+
     def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         """Noisy measurements ``h(x) + v Dᵀ`` of a batch; ``v`` of shape (..., q)."""
         return self.function(x) + np.asarray(v) @ self.D.T
@@ -180,6 +187,12 @@ class LinearMeasurement(MeasurementModel):
 
     def measure(self, x: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
         return np.asarray(x) @ self.H.T + np.asarray(v) @ self.D.T
+
+    def compiled_functions(self) -> CompiledMeasurement:
+        """``H x`` and H for one state, numba-compiled (:mod:`hinfnav.systems.compiled`)."""
+        fns = package_functions()
+        return CompiledMeasurement(fns.linear_h, fns.linear_h_jacobian, fns.plain_residual,
+                                   np.concatenate([self.H.shape, self.H.ravel()]))
 
 
 # ---------------------------------------------------------------------------
@@ -375,6 +388,12 @@ class RangeAzimuthElevation(MeasurementModel):
         out = self.function(x) + np.asarray(v) @ self.D.T
         out[..., 1] = wrap_angle(out[..., 1])
         return out
+
+    def compiled_functions(self) -> CompiledMeasurement:
+        """Range, azimuth, elevation and their Jacobian for one state, numba-compiled (:mod:`hinfnav.systems.compiled`)."""
+        fns = package_functions()
+        return CompiledMeasurement(fns.range_angles_h, fns.range_angles_jacobian, fns.angles_residual,
+                                   np.concatenate([[self.n_state], self._rotation().ravel()]))
 
     def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """The indirect position measurement: position (m) from (ρ, α, β), eq. (7)."""

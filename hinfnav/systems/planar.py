@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_positive, as_vector
+from .compiled import CompiledMeasurement, package_functions
 from .measurements import ConvertedPosition, MeasurementModel, RangeAzimuthElevation
 
 __all__ = ["RangeBearing", "ConvertedRangeBearing"]
@@ -90,6 +91,12 @@ class RangeBearing(MeasurementModel):
     # bearing wrapped: the 3-D sensor's, whose angles are its channels 1: as the bearing is here
     residual = RangeAzimuthElevation.residual
     measure = RangeAzimuthElevation.measure
+
+    def compiled_functions(self) -> CompiledMeasurement:
+        """(P1)-(P2) and the wrapped residual for one state, numba-compiled (:mod:`hinfnav.systems.compiled`)."""
+        fns = package_functions()
+        return CompiledMeasurement(fns.range_bearing_h, fns.range_bearing_jacobian, fns.angles_residual,
+                                   np.concatenate([[self.n_state], self.position, self.origin]))
 
     def inverse(self, m: ArrayLike) -> NDArray[np.float64]:
         """(P3) The position ``o + r (cos b, sin b)`` of readings (r, b), shape (..., 2), m."""
