@@ -18,18 +18,11 @@ Names are loaded lazily (PEP 562, :mod:`hinfnav.core.lazy`): ``import hinfnav``
 is cheap, and the heavy layers (cvxpy, python-control, matplotlib) are imported
 on first use, so the command line starts fast.
 
-Sun 2011's names (``hinfnav.Scenario``, ``hinfnav.design_for_scenario``, …)
-were re-exported here up to 0.2; they still resolve, for one release, with a
-:class:`FutureWarning` naming their home (``hinfnav.papers.sun2011.Scenario``).
-A FutureWarning rather than a DeprecationWarning: Python shows a
-DeprecationWarning only when it is attributed to ``__main__``, and ``from hinfnav
-import Scenario`` reaches this module's ``__getattr__`` through the import
-machinery, so a notebook's or a script's user would never see it.
+Sun 2011's names (``Scenario``, ``design_for_scenario``, …), re-exported here
+up to 0.2, live in :mod:`hinfnav.papers.sun2011` only (removed here in 0.3).
 """
 
 import importlib
-import sys
-import warnings
 from typing import TYPE_CHECKING
 
 from .core.lazy import exported_from, lazy_exports
@@ -72,45 +65,12 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
     )
     from .campaign import Campaign, load_campaign, read_campaign, run_campaign
 
-#: Sun 2011's names, once exported here: name -> their home. Deprecated aliases for one release (0.3):
-#: each use warns (FutureWarning), and they are in neither ``__all__`` nor ``dir(hinfnav)``.
-_MOVED = {name: "papers.sun2011" for name in (
-    "mixed_design_for_scenario",
-    "EKF",
-    "FILTER_NAMES",
-    "GammaSweep",
-    "KalmanLimit",
-    "Scenario",
-    "build_ekf",
-    "compare_with_published",
-    "design_for_scenario",
-    "design_report",
-    "gamma_sweep",
-    "infer_sampling_time",
-    "kalman_limit",
-    "load_design",
-    "lti_error_covariance",
-    "make_estimator",
-    "published_filter",
-    "range_angle_measurements",
-    "save_design",
-)}
-
 _lazy_getattr, __dir__ = lazy_exports(__name__)
 
 
 def __getattr__(name: str) -> object:
     if name == "__version__":  # the installed distribution's (see io.provenance.package_version); computed once
         globals()[name] = value = importlib.import_module(".io.provenance", __name__).package_version()
-        return value
-    home = _MOVED.get(name)
-    if home is not None:  # not cached: every use warns
-        value = getattr(importlib.import_module(f".{home}", __name__), name)
-        # ``from hinfnav import X`` first probes X from importlib's frozen frames (hasattr), then reads it
-        # from the importing line: warn once, on the second, which points at the user's line.
-        if not sys._getframe(1).f_code.co_filename.startswith("<frozen importlib"):
-            warnings.warn(f"hinfnav.{name} is deprecated and will be removed after 0.3: use hinfnav.{home}.{name} "
-                          f"(from hinfnav.{home} import {name})", FutureWarning, stacklevel=2)
         return value
     return _lazy_getattr(name)
 
