@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from importlib import metadata
 from typing import TYPE_CHECKING, Any
 
-from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..core.validation import as_choice
 from .sqrt import FORMS, square_root
@@ -197,7 +196,6 @@ def register_estimator(name: str, builder: Callable[..., Estimator], *, fits: Ca
     _REGISTRY[name] = _Entry(name, builder, fits or (lambda scenario: True), description, requires)
 
 
-@scenario_moved("name", "scenario", was=str)
 def fit_reason(scenario: Any, name: str) -> str | None:
     """Why the estimator ``name`` does not fit ``scenario`` (None: it fits).
 
@@ -236,7 +234,6 @@ def estimator_entry(name: str) -> _Entry:
     return _REGISTRY[name]
 
 
-@scenario_moved("name", "scenario", was=str)
 def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph", **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``.
 

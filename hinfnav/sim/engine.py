@@ -46,7 +46,6 @@ of one batch, whatever the runs).
 
 from __future__ import annotations
 
-import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
@@ -56,7 +55,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
-from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..core.protocols import CampaignTruthScenario, OwnTruthScenario
 from ..io.progress import bar_disabled
@@ -107,13 +105,6 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
     return seed
 
 
-def _names_estimators(value: Any) -> bool:
-    """Whether ``value`` is what came first in ``resolve_estimator(s)``'s earlier order: estimators, never a scenario."""
-    design = getattr(sys.modules.get("hinfnav.design.result"), "SynthesisResult", ())  # no design without its module
-    return isinstance(value, (str, Estimator, Mapping, Sequence, design))
-
-
-@scenario_moved("estimator", "scenario", was=_names_estimators)
 def resolve_estimator(scenario: Any, estimator: str | Estimator | SynthesisResult) -> Estimator:
     """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a name for ``scenario``, or built from a design.
 
@@ -143,7 +134,6 @@ def _estimator_like(obj: Any) -> bool:
     return isinstance(obj, Estimator) or (callable(getattr(obj, "estimate", None)) and hasattr(obj, "measurement"))
 
 
-@scenario_moved("estimators", "scenario", was=_names_estimators)
 def resolve_estimators(scenario: Any, estimators: Any) -> dict[str, Estimator]:
     """Name → Estimator from one estimator, a sequence of them, or a mapping name → estimator (names unique)."""
     if isinstance(estimators, Mapping):

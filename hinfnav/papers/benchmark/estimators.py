@@ -32,7 +32,6 @@ sigma-point and a Huber filter beside its AEKF, ASTEKF and AAEKF.
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...estimators.attitude import AttitudeHuberEKF
 from ...estimators.augmented import AugmentedInputAdaptiveKF
@@ -79,7 +78,6 @@ def _model(scenario):
     raise InputError(f"scenario {type(scenario).__name__} offers no kalman_model()")
 
 
-@scenario_moved("kind", "scenario", was=str)
 def build_generic(scenario, kind, **options):
     """One of the eight filters of the module table on ``scenario``'s Kalman model (``options`` to its class)."""
     m = _model(scenario)

@@ -10,11 +10,9 @@ function takes ``ax=``/``axes=`` or returns a figure from
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure, plot_error_axis
 from .constants import MANEUVER_TIME_S, PAPER_RESULTS
-from .studies import CaseResult
 
 __all__ = [
     "FILTER_STYLE",
@@ -158,7 +156,6 @@ def mixture_figures(mixture, summary=None):
                           f"{_numbers(summary, 'mixture', 'velocity')}"))
 
 
-@scenario_moved("result", "scenario", was=CaseResult)
 def plot_maneuver_bias(scenario, result, *, axes, filters=("ekf", "hbf"), span_s=300.0):
     """Mean error over the runs (the bias) of x and vx around the maneuver: how fast each filter follows it.
 
@@ -193,7 +190,6 @@ def plot_maneuver_bias(scenario, result, *, axes, filters=("ekf", "hbf"), span_s
     return artists
 
 
-@scenario_moved("result", "scenario", was=CaseResult)
 def maneuver_figure(scenario, result):
     """The reaction to the maneuver, mean over the Monte Carlo runs."""
     fig, axes = new_figure(1, 2, figsize=(10, 3.4))

@@ -30,7 +30,6 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
 from ...estimators.registry import Requires, register_estimator
-from .arguments import scenario_first
 from .constants import published_filter
 from .designs import design_for_scenario
 from .ekf import build_ekf
@@ -49,7 +48,6 @@ FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_clos
 VERBATIM = ("published_closed_loop", "designed_closed_loop", "designed_observer_closed_loop")
 
 
-@scenario_first("A_F", "B_F", "C_F", "scenario")
 def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):
     """Wrap filter matrices designed on ``scenario``'s closed loop as an estimator.
 
@@ -82,7 +80,6 @@ def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_
     return scenario.lti_filter(A_F, B_F, C_F, name=name, uses_input=uses_input, design_dt=design_dt)
 
 
-@scenario_first("name", "scenario")
 def make_estimator(scenario: Scenario, name: str, **options: Any) -> Estimator:
     """Build an estimator by name (see the module table).
 

@@ -35,7 +35,6 @@ from ...core.validation import as_int_at_least, as_positive
 from ...design.mixed import front_gammas, knee_index, mixed_front, synthesize_mixed
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
-from .arguments import scenario_first
 from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from, with_grid
 from .scenario import Scenario
 
@@ -219,7 +218,6 @@ def _h2_fields(res):
     }
 
 
-@scenario_first("delta_bar", "gamma", "solver", "scenario", "points")
 def mixed_design_report(scenario=None, delta_bar=None, gamma=None, solver=None, points=12):
     """JSON-ready summary of a mixed design, or of the front and its knee.
 
