@@ -1,8 +1,7 @@
 """The one Monte Carlo engine: truths batch by batch, estimators on them, results into a sink.
 
 :func:`run_monte_carlo` is the loop every Monte Carlo of the package goes
-through (:func:`~hinfnav.sim.simulate`, :func:`~hinfnav.sim.simulate_nonlinear`,
-:func:`~hinfnav.sim.simulate_closed_loop`,
+through (:func:`~hinfnav.sim.simulate`, :func:`~hinfnav.sim.simulate_closed_loop`,
 :func:`hinfnav.metrics.monte_carlo_statistics` and a campaign cell)::
 
     for each batch of runs [start, start + n):
