@@ -10,8 +10,10 @@ The package is layered, each layer importing only those before it:
 ``design`` → ``estimators`` → ``control`` → ``sim`` → ``metrics`` →
 ``plotting`` → ``campaign`` → ``papers`` → ``cli`` (checked by import-linter,
 ``pyproject.toml``, and at import time by ``tests/test_import_time.py``).
-The names below are the generic public API, re-exported from those layers;
-each paper's names live in its own package, :mod:`hinfnav.papers.sun2011` and
+The names below are the generic public API a user starts from (about 50),
+re-exported from those layers; the rest of each layer's API is in its
+subpackage (``hinfnav.systems``, ``hinfnav.analysis``, …), and each paper's
+names live in its own package, :mod:`hinfnav.papers.sun2011` and
 its peers.
 
 Names are loaded lazily (PEP 562, :mod:`hinfnav.core.lazy`): ``import hinfnav``
@@ -29,7 +31,7 @@ from .core.lazy import exported_from, lazy_exports
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .core import (
-        CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
+        CertificationError, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
         UnstablePlantError,
     )
     from .core.protocols import (  # "X as X": re-exported, their __all__ entries read from this block
@@ -39,30 +41,21 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
         ScenarioProtocol as ScenarioProtocol, TruthModelProtocol as TruthModelProtocol,
     )
     from .systems import (
-        hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
-        position_from_range_angles, range_angles, RangeAzimuthElevation, Saturated, StateSpec,
-        two_mass_spring, UncertainSystem, uncertainty_F, uncertainty_structure, polytope_from_parameters,
-        polytope_coverage, flexible_attitude, flexible_attitude_closed_loop,
+        LinearMeasurement, LinearSystem, PolytopicSystem, RangeAzimuthElevation, Saturated, StateSpec, UncertainSystem,
     )
-    from .noise import make_noise, NOISE_NAMES
-    from .analysis import (
-        h2_norm, hinf_norm, observer_form, steady_state_hinf, steady_state_kalman, truncated_normal_moments,
-        worst_case_norm,
-    )
+    from .noise import make_noise
+    from .analysis import h2_norm, hinf_norm
     from .design import (
-        MixedSynthesisResult, PolytopicResult, recertify, SampleSet, SolverOptions, SynthesisResult,
+        MixedSynthesisResult, PolytopicResult, recertify, SolverOptions, SynthesisResult,
         synthesize, synthesize_mixed, synthesize_polytopic,
     )
     from .estimators import (
-        build_estimator, EstimateHistory, Estimator, ExtendedKalmanFilter, FilterState, huber_update,
+        build_estimator, Estimator, ExtendedKalmanFilter,
         HuberFilter, LTIFilter, RecursiveHInfinityFilter, register_estimator, registered_estimators,
-        StepOutput,
     )
     from .control import LinearFeedback
     from .sim import simulate, simulate_closed_loop, simulate_truth, SimulationResult, TruthModel
-    from .metrics import (
-        convergence_time, max_error, monte_carlo_statistics, monte_carlo_summary, rms_error, rms_per_run,
-    )
+    from .metrics import monte_carlo_statistics, monte_carlo_summary, rms_error
     from .campaign import Campaign, load_campaign, read_campaign, run_campaign
 
 _lazy_getattr, __dir__ = lazy_exports(__name__)
@@ -79,34 +72,16 @@ __all__ = [
     # systems
     "StateSpec",
     "LinearSystem",
-    "MeasurementModel",
     "LinearMeasurement",
     "RangeAzimuthElevation",
     "Saturated",
     "UncertainSystem",
     "PolytopicSystem",
-    "two_mass_spring",
-    "polytope_from_parameters",
-    "polytope_coverage",
-    "flexible_attitude",
-    "flexible_attitude_closed_loop",
-    "hill_matrices",
-    "uncertainty_structure",
-    "uncertainty_F",
-    "discretize",
-    "range_angles",
-    "position_from_range_angles",
     # noise
     "make_noise",
-    "NOISE_NAMES",
     # analysis
     "hinf_norm",
     "h2_norm",
-    "worst_case_norm",
-    "steady_state_kalman",
-    "observer_form",
-    "steady_state_hinf",
-    "truncated_normal_moments",
     # design
     "synthesize",
     "run_campaign",
@@ -119,18 +94,13 @@ __all__ = [
     "RecursiveHInfinityFilter",
     "SynthesisResult",
     "SolverOptions",
-    "SampleSet",
     "synthesize_polytopic",
     "PolytopicResult",
     "recertify",
     # estimators
     "Estimator",
-    "EstimateHistory",
-    "FilterState",
-    "StepOutput",
     "LTIFilter",
     "ExtendedKalmanFilter",
-    "huber_update",
     "register_estimator",
     "build_estimator",
     "registered_estimators",
@@ -143,9 +113,6 @@ __all__ = [
     "SimulationResult",
     # metrics
     "rms_error",
-    "rms_per_run",
-    "max_error",
-    "convergence_time",
     "monte_carlo_summary",
     "monte_carlo_statistics",
     # protocols (hinfnav.core.protocols): what your own scenario, system, sensor, filter, design offer
