@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable
 
-__all__ = ["Candidate", "Loop", "solve_and_certify"]
+__all__ = ["Candidate", "solve_and_certify"]
 
 
 @dataclass

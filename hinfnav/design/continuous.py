@@ -41,7 +41,7 @@ from ..lmi.continuous import certify_continuous, solve_continuous_observer
 from ..systems.continuous import ContinuousPolytope
 from ..systems.polytopic import simplex_grid
 
-__all__ = ["synthesize_continuous_observer", "continuous_augmented", "ContinuousResult", "design_continuous_system"]
+__all__ = ["synthesize_continuous_observer", "ContinuousResult", "design_continuous_system"]
 
 COVERS_CONTINUOUS = ("every α constant in time in the simplex (parameter-dependent Lyapunov function), "
                      "continuous time")

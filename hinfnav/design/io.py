@@ -38,7 +38,7 @@ from ..systems.uncertain import UncertainSystem
 from .polytopic import PolytopicResult
 from .result import SynthesisResult
 
-__all__ = ["FORMAT", "system_fingerprint", "content_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
+__all__ = ["system_fingerprint", "content_fingerprint", "save_design", "load_design",
            "check_design_system", "check_design_path"]
 
 #: Identifier and version of the file format.

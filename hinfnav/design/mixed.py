@@ -69,7 +69,7 @@ from .arguments import system_argument
 from .result import SynthesisResult
 from .samples import SampleSet, check_plant, check_samples, default_uncertainty_samples
 
-__all__ = ["MIXED_SOLVER_OPTIONS", "MixedSynthesisResult", "MixedFront", "synthesize_mixed", "mixed_front",
+__all__ = ["MixedSynthesisResult", "MixedFront", "synthesize_mixed", "mixed_front",
            "front_gammas", "knee_index"]
 
 #: Default solver choices of the mixed synthesis: CVXOPT first. On these LMIs Clarabel stops with
