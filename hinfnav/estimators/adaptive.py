@@ -58,7 +58,6 @@ __all__ = [
     "fading_factors",
     "innovation_moment",
     "input_rate",
-    "per_run_parameter",
     "rate_adapted_density",
 ]
 

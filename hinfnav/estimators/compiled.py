@@ -64,7 +64,7 @@ from ..systems.linear import LinearSystem
 from ..systems.measurements import MeasurementModel
 from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
 
-__all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
+__all__ = ["BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status",
            "run_compiled", "select_backend", "use_backend", "why_numpy"]
 
 #: What ``Estimator.estimate(backend=...)`` accepts.

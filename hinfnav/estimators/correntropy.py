@@ -49,7 +49,7 @@ from .variational import DataDependentCorrection, _from_ekf, _prior_per_run, _sw
 if TYPE_CHECKING:
     from .base import FilterState
 
-__all__ = ["CorrentropyCorrection", "CorrentropyFilter", "WEIGHT_FLOOR"]
+__all__ = ["CorrentropyCorrection", "CorrentropyFilter"]
 
 #: Smallest kernel weight G_σ(e) used (see the module docstring).
 WEIGHT_FLOOR = 1e-100

@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["register_estimator", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
-           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS", "CORE_OPTIONS"]
+           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "CORE_OPTIONS"]
 
 #: Options every estimator takes whatever its builder (issue 36): applied by :func:`build_estimator` to the built
 #: estimator through the :class:`~hinfnav.estimators.base.Estimator` contract (``missing``, its property).
