@@ -27,7 +27,7 @@ from .forksafety import note_solve
 if TYPE_CHECKING:
     from .conditioning import Prepared
 
-__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
+__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SolverOptions", "Solution", "LMIProblem",
            "run_solver", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi"]
 
 #: Solvers the synthesis accepts (cvxpy names).
