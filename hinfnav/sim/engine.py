@@ -70,8 +70,8 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["Sink", "HistorySink", "run_monte_carlo", "truth_batch", "truth_batches", "estimate_on_truth",
-           "closed_loop_batch", "truth_runs", "resolve_estimator", "resolve_estimators", "check_measurement_match", "plain_seed",
-           "results_from_parts", "batch_result"]
+           "closed_loop_batch", "resolve_estimator", "resolve_estimators", "check_measurement_match",
+           "batch_result"]
 
 
 class Sink:
