@@ -46,13 +46,8 @@ from ..sun2011.scenario import Scenario as ChaserScenario
 
 __all__ = [
     "P0_THRUST_STD",
-    "Q_THRUST",
     "Q_THRUST_BASE",
-    "THRUST_EPSILON",
-    "THRUST_RATE_MAX",
-    "THRUST_MEMORY_STEPS",
     "WINDOWS",
-    "SWEEPS",
     "ChaserStudy",
     "build_augmented_thrust",
     "chaser_study",
@@ -61,7 +56,6 @@ __all__ = [
     "plot_chaser",
     "plot_thrust_estimates",
     "run_passes",
-    "window_stats",
 ]
 
 #: Bound on the thrust's rate of change, N/s (documented prior; the truth's largest is 93 N/s).

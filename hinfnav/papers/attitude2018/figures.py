@@ -13,8 +13,6 @@ from .constants import PAPER_Q_ASTEKF, PAPER_Q_BEST_AEKF
 from .studies import EPSILON_FACTORS
 
 __all__ = [
-    "AXES",
-    "FIG_Q",
     "fig1",
     "fig2",
     "fig3",
@@ -26,10 +24,8 @@ __all__ = [
     "fig9",
     "fig_error_vs_rate",
     "fig_fading",
-    "fig_filter",
     "fig_q_sweep",
     "fig_tuning",
-    "plot_error_axes",
     "plot_torque",
 ]
 

@@ -37,14 +37,10 @@ from .scenario import Scenario, default_epsilon
 
 __all__ = [
     "EPSILON_FACTORS",
-    "ST_GRID",
-    "WINDOW_VALUES",
     "AttitudeStudy",
     "FilterStats",
     "attitude_study",
-    "dominant_period",
     "filter_stats",
-    "first_runs",
     "run_batched",
     "run_filter",
     "sweep_study",

@@ -48,7 +48,7 @@ from ..attitude2018.scenario import Scenario as AttitudeScenario
 from ..shi2018.campaign import kalman_model as shi_kalman_model
 from ..shi2018.scenario import Scenario as ShiScenario
 
-__all__ = ["GENERIC", "build_generic", "build_attitude_hbf", "build_attitude_ukf"]
+__all__ = ["build_generic", "build_attitude_hbf", "build_attitude_ukf"]
 
 #: Name → (kind, description).
 GENERIC = {

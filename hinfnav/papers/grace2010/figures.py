@@ -6,7 +6,7 @@ from scipy.ndimage import uniform_filter1d
 from ...plotting.errors import new_figure
 from .constants import TRUTH_SIGMA_M
 
-__all__ = ["truth_figure", "mismatch_figure", "errors_figure", "RELATIVE_TRUTH_SIGMA_M"]
+__all__ = ["truth_figure", "mismatch_figure", "errors_figure"]
 
 #: 1σ of the truth's relative position per axis, m: two independent ≈ 2 cm orbits, √2 × 2 cm.
 RELATIVE_TRUTH_SIGMA_M = float(np.sqrt(2.0) * TRUTH_SIGMA_M)

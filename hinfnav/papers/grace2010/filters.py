@@ -51,7 +51,7 @@ from .dataset import hill_to_inertial, inertial_to_hill
 from .dynamics import MODELS, pair, rk4
 from .mismatch import SUBSTEPS, hill_transition
 
-__all__ = ["NonlinearPredictionEKF", "DESIGN_DAMPING", "P0_STD", "Q_ACCEL", "Q_INPUT_DENSITY", "model_mismatch_moment",
+__all__ = ["NonlinearPredictionEKF", "DESIGN_DAMPING", "P0_STD", "model_mismatch_moment",
            "lmi_designs", "build_filters", "FILTER_NAMES"]
 
 #: Damping of the LMI design model (see the module notes): ρ Φ(ω₀).

@@ -48,7 +48,7 @@ from .constants import (
     OUTLIER_SCALE,
 )
 
-__all__ = ["VARIANTS", "DROPOUT_BLOCK", "MeasurementSet", "kband_noise", "make_measurements", "linear_form",
+__all__ = ["VARIANTS", "MeasurementSet", "kband_noise", "make_measurements", "linear_form",
            "shared_model_groups"]
 
 VARIANTS = ("kband_angles", "gnss", "gnss_outliers", "gnss_dropouts")

@@ -15,7 +15,6 @@ from ...plotting.errors import new_figure, plot_error_axis
 from .constants import MANEUVER_TIME_S, PAPER_RESULTS
 
 __all__ = [
-    "FILTER_STYLE",
     "plot_case_errors",
     "errors_figure",
     "fig3",
@@ -25,7 +24,6 @@ __all__ = [
     "mixture_figures",
     "plot_maneuver_bias",
     "maneuver_figure",
-    "plot_ratio_sweep",
     "sweeps_figure",
 ]
 

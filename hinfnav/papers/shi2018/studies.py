@@ -36,22 +36,16 @@ __all__ = [
     "FilterStats",
     "CaseResult",
     "case_conditions",
-    "default_filters",
     "run_case",
     "accuracy",
-    "mc_interval",
     "filter_summary",
     "paired_gap",
     "maneuver_reaction",
-    "MANEUVER_WINDOWS",
     "maneuver_windows",
 ]
 
 #: The paper's cases (§3.1–3.3).
 CASES = ("gaussian", "mixture", "maneuver")
-
-#: Extra windows of the maneuver case: before it (from the window's start), the 200 s after it, the last 200 s.
-MANEUVER_WINDOWS = ("before", "reaction", "final")
 
 
 def maneuver_windows(scenario):

@@ -38,14 +38,11 @@ from .scenario import Scenario
 if TYPE_CHECKING:
     from ...estimators.base import Estimator
 
-__all__ = ["FILTER_NAMES", "VERBATIM", "BUILDERS", "make_estimator", "build_published", "build_designed",
+__all__ = ["FILTER_NAMES", "BUILDERS", "make_estimator", "build_published", "build_designed",
            "lti_from_matrices"]
 
 FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                 "designed_observer_closed_loop", "ekf", "ekf_known_input")
-
-#: Filters run exactly as (12), assuming u = K x (the others are told the applied thrust).
-VERBATIM = ("published_closed_loop", "designed_closed_loop", "designed_observer_closed_loop")
 
 
 def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):

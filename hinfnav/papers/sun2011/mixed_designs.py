@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from ...design.mixed import MixedSynthesisResult
 
 __all__ = ["mixed_design_for_scenario", "mixed_front_for_scenario", "mixed_design_report",
-           "format_mixed_design_report", "analysis_gamma", "certify_front", "certified_knee"]
+           "format_mixed_design_report", "certified_knee"]
 
 
 def _setup(scenario, delta_bar, delta_points, options):

@@ -28,11 +28,9 @@ __all__ = [
     "step_response",
     "saturation_summary",
     "linear_loop_radius",
-    "replay_alg2",
     "truncated",
     "asd_sensitivity",
     "SENSITIVITY_NPERSEG",
-    "THETA_READINGS",
     "theta_readings_study",
 ]
 
