@@ -10,13 +10,13 @@ import argparse
 import time
 
 from hinfnav.papers.attitude2018 import Scenario, build_aaekf, build_aekf, build_astekf
-from hinfnav.sim.nonlinear import simulate_nonlinear_truth
+from hinfnav.sim import simulate_truth
 
 
 def bench(runs, steps, repeat):
     sc = Scenario()
     sc = sc.replace(orbits=steps * sc.dt / sc.orbital_period)
-    truth = simulate_nonlinear_truth(sc.truth_model(), runs=runs, seed=0)
+    truth = simulate_truth(sc.truth_model(), runs=runs, seed=0)
     n = truth.x.shape[1]
     rows = []
     for build in (build_aekf, build_astekf, build_aaekf):

@@ -10,33 +10,28 @@ The package is layered, each layer importing only those before it:
 ``design`` → ``estimators`` → ``control`` → ``sim`` → ``metrics`` →
 ``plotting`` → ``campaign`` → ``papers`` → ``cli`` (checked by import-linter,
 ``pyproject.toml``, and at import time by ``tests/test_import_time.py``).
-The names below are the generic public API, re-exported from those layers;
-each paper's names live in its own package, :mod:`hinfnav.papers.sun2011` and
+The names below are the generic public API a user starts from (about 50),
+re-exported from those layers; the rest of each layer's API is in its
+subpackage (``hinfnav.systems``, ``hinfnav.analysis``, …), and each paper's
+names live in its own package, :mod:`hinfnav.papers.sun2011` and
 its peers.
 
 Names are loaded lazily (PEP 562, :mod:`hinfnav.core.lazy`): ``import hinfnav``
 is cheap, and the heavy layers (cvxpy, python-control, matplotlib) are imported
 on first use, so the command line starts fast.
 
-Sun 2011's names (``hinfnav.Scenario``, ``hinfnav.design_for_scenario``, …)
-were re-exported here up to 0.2; they still resolve, for one release, with a
-:class:`FutureWarning` naming their home (``hinfnav.papers.sun2011.Scenario``).
-A FutureWarning rather than a DeprecationWarning: Python shows a
-DeprecationWarning only when it is attributed to ``__main__``, and ``from hinfnav
-import Scenario`` reaches this module's ``__getattr__`` through the import
-machinery, so a notebook's or a script's user would never see it.
+Sun 2011's names (``Scenario``, ``design_for_scenario``, …), re-exported here
+up to 0.2, live in :mod:`hinfnav.papers.sun2011` only (removed here in 0.3).
 """
 
 import importlib
-import sys
-import warnings
 from typing import TYPE_CHECKING
 
 from .core.lazy import exported_from, lazy_exports
 
 if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_exports (each loaded on first use)
     from .core import (
-        CertificationError, discretize, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
+        CertificationError, HinfnavError, InfeasibleLMIError, InputError, SynthesisError,
         UnstablePlantError,
     )
     from .core.protocols import (  # "X as X": re-exported, their __all__ entries read from this block
@@ -46,55 +41,22 @@ if TYPE_CHECKING:  # the lazy exports: read by type checkers, and by lazy_export
         ScenarioProtocol as ScenarioProtocol, TruthModelProtocol as TruthModelProtocol,
     )
     from .systems import (
-        hill_matrices, LinearMeasurement, LinearSystem, MeasurementModel, PolytopicSystem,
-        position_from_range_angles, range_angles, RangeAzimuthElevation, Saturated, StateSpec,
-        two_mass_spring, UncertainSystem, uncertainty_F, uncertainty_structure, polytope_from_parameters,
-        polytope_coverage, flexible_attitude, flexible_attitude_closed_loop,
+        LinearMeasurement, LinearSystem, PolytopicSystem, RangeAzimuthElevation, Saturated, StateSpec, UncertainSystem,
     )
-    from .noise import make_noise, NOISE_NAMES
-    from .analysis import (
-        h2_norm, hinf_norm, observer_form, steady_state_hinf, steady_state_kalman, truncated_normal_moments,
-        worst_case_norm,
-    )
+    from .noise import make_noise
+    from .analysis import h2_norm, hinf_norm
     from .design import (
-        DesignResult, recertify, SampleSet, SolverOptions,
+        DesignResult, recertify, SolverOptions,
         synthesize, synthesize_mixed, synthesize_polytopic,
     )
     from .estimators import (
-        build_estimator, EstimateHistory, Estimator, ExtendedKalmanFilter, FilterState, huber_update,
+        build_estimator, Estimator, ExtendedKalmanFilter,
         HuberFilter, LTIFilter, RecursiveHInfinityFilter, register_estimator, registered_estimators,
-        StepOutput,
     )
     from .control import LinearFeedback
     from .sim import simulate, simulate_closed_loop, simulate_truth, SimulationResult, TruthModel
-    from .metrics import (
-        convergence_time, max_error, monte_carlo_statistics, monte_carlo_summary, rms_error, rms_per_run,
-    )
+    from .metrics import monte_carlo_statistics, monte_carlo_summary, rms_error
     from .campaign import Campaign, load_campaign, read_campaign, run_campaign
-
-#: Sun 2011's names, once exported here: name -> their home. Deprecated aliases for one release (0.3):
-#: each use warns (FutureWarning), and they are in neither ``__all__`` nor ``dir(hinfnav)``.
-_MOVED = {name: "papers.sun2011" for name in (
-    "mixed_design_for_scenario",
-    "EKF",
-    "FILTER_NAMES",
-    "GammaSweep",
-    "KalmanLimit",
-    "Scenario",
-    "build_ekf",
-    "compare_with_published",
-    "design_for_scenario",
-    "design_report",
-    "gamma_sweep",
-    "infer_sampling_time",
-    "kalman_limit",
-    "load_design",
-    "lti_error_covariance",
-    "make_estimator",
-    "published_filter",
-    "range_angle_measurements",
-    "save_design",
-)}
 
 _lazy_getattr, __dir__ = lazy_exports(__name__)
 
@@ -103,15 +65,6 @@ def __getattr__(name: str) -> object:
     if name == "__version__":  # the installed distribution's (see io.provenance.package_version); computed once
         globals()[name] = value = importlib.import_module(".io.provenance", __name__).package_version()
         return value
-    home = _MOVED.get(name)
-    if home is not None:  # not cached: every use warns
-        value = getattr(importlib.import_module(f".{home}", __name__), name)
-        # ``from hinfnav import X`` first probes X from importlib's frozen frames (hasattr), then reads it
-        # from the importing line: warn once, on the second, which points at the user's line.
-        if not sys._getframe(1).f_code.co_filename.startswith("<frozen importlib"):
-            warnings.warn(f"hinfnav.{name} is deprecated and will be removed after 0.3: use hinfnav.{home}.{name} "
-                          f"(from hinfnav.{home} import {name})", FutureWarning, stacklevel=2)
-        return value
     return _lazy_getattr(name)
 
 __all__ = [
@@ -119,34 +72,16 @@ __all__ = [
     # systems
     "StateSpec",
     "LinearSystem",
-    "MeasurementModel",
     "LinearMeasurement",
     "RangeAzimuthElevation",
     "Saturated",
     "UncertainSystem",
     "PolytopicSystem",
-    "two_mass_spring",
-    "polytope_from_parameters",
-    "polytope_coverage",
-    "flexible_attitude",
-    "flexible_attitude_closed_loop",
-    "hill_matrices",
-    "uncertainty_structure",
-    "uncertainty_F",
-    "discretize",
-    "range_angles",
-    "position_from_range_angles",
     # noise
     "make_noise",
-    "NOISE_NAMES",
     # analysis
     "hinf_norm",
     "h2_norm",
-    "worst_case_norm",
-    "steady_state_kalman",
-    "observer_form",
-    "steady_state_hinf",
-    "truncated_normal_moments",
     # design
     "synthesize",
     "run_campaign",
@@ -158,17 +93,12 @@ __all__ = [
     "RecursiveHInfinityFilter",
     "DesignResult",
     "SolverOptions",
-    "SampleSet",
     "synthesize_polytopic",
     "recertify",
     # estimators
     "Estimator",
-    "EstimateHistory",
-    "FilterState",
-    "StepOutput",
     "LTIFilter",
     "ExtendedKalmanFilter",
-    "huber_update",
     "register_estimator",
     "build_estimator",
     "registered_estimators",
@@ -181,9 +111,6 @@ __all__ = [
     "SimulationResult",
     # metrics
     "rms_error",
-    "rms_per_run",
-    "max_error",
-    "convergence_time",
     "monte_carlo_summary",
     "monte_carlo_statistics",
     # protocols (hinfnav.core.protocols): what your own scenario, system, sensor, filter, design offer

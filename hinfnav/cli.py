@@ -19,7 +19,7 @@ from .core.exceptions import HinfnavError, InputError
 from .io.outputs import check_output_dir, dumps_strict
 from .core.validation import check_new_file
 
-__all__ = ["main", "simulate_report", "format_simulate_report", "RegistryChoices", "FILTER_CHOICES",
+__all__ = ["main", "simulate_report", "format_simulate_report", "FILTER_CHOICES",
            "NOISE_CHOICES", "SOLVER_CHOICES", "PAPER_CHOICES", "MAX_RUNS"]
 
 

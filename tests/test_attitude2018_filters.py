@@ -31,7 +31,7 @@ from hinfnav.papers.attitude2018 import (
     build_augmented_thrust,
 )
 from hinfnav.papers.sun2011 import Scenario as ChaserScenario
-from hinfnav.sim.nonlinear import simulate_nonlinear_truth
+from hinfnav.sim import simulate_truth
 
 SC = Scenario(orbits=0.05)  # 293 steps of 1 s
 BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}
@@ -39,7 +39,7 @@ BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}
 
 @pytest.fixture(scope="module")
 def truth():
-    return simulate_nonlinear_truth(SC.truth_model(), runs=3, seed=11)
+    return simulate_truth(SC.truth_model(), runs=3, seed=11)
 
 
 @pytest.fixture(scope="module", params=ATTITUDE_FILTERS)

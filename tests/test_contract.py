@@ -29,7 +29,6 @@ from hinfnav.papers.yang2020 import ESTIMATOR_NAMES as YANG_NAMES
 from hinfnav.papers.yang2020 import SUBSYSTEM_OF
 from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.sim import simulate_truth
-from hinfnav.sim.nonlinear import simulate_nonlinear, simulate_nonlinear_truth
 
 SCENARIO = Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0))
 SHI = ShiScenario(duration_s=40.0, rms_window_s=(4.0, 40.0), maneuver_time_s=20.0)
@@ -80,8 +79,8 @@ def make_case(name):
         return Case(name, "shi2018", SHI, est, truth, lambda e, **kw: hn.simulate(SHI, e, **kw))
     if name in registered_estimators(ATTITUDE):
         est = build_estimator(ATTITUDE, name)
-        truth = _truth("attitude2018", lambda: simulate_nonlinear_truth(ATTITUDE.truth_model(), runs=3, seed=11))
-        return Case(name, "attitude2018", ATTITUDE, est, truth, lambda e, **kw: simulate_nonlinear(ATTITUDE, e, **kw))
+        truth = _truth("attitude2018", lambda: hn.simulate_truth(ATTITUDE.truth_model(), runs=3, seed=11))
+        return Case(name, "attitude2018", ATTITUDE, est, truth, lambda e, **kw: hn.simulate(ATTITUDE, e, keep_covariance=False, diagnostics=False, **kw))
     lt = YANG.linear_truth(SUBSYSTEM_OF[name])
     truth = _truth(name, lambda: simulate_truth(lt.truth_model(), runs=3, seed=7))
     return Case(name, "yang2020", lt, build_estimator(lt, name), truth, lambda e, **kw: hn.simulate(lt, e, **kw))
@@ -210,7 +209,8 @@ def test_converges_without_noise_on_a_stable_problem(case):
     elif case.paper == "attitude2018":
         # limit 0: no measurement noise, a negligible torque (T0 = 1e-12 N m); initial errors ~1e-2 rad
         sc = AttitudeScenario(orbits=0.1, T0=1e-12)
-        res = simulate_nonlinear(sc, build_estimator(sc, case.name), runs=1, noise=ZeroNoise())
+        res = hn.simulate(sc, build_estimator(sc, case.name), runs=1, noise=ZeroNoise(), keep_covariance=False,
+                          diagnostics=False)
         e = np.abs(res.error[0, -1])
         assert np.all(e[:3] < 1e-9) and np.all(e[3:6] < 1e-10) and np.all(e[6:] < 1e-11), (case.name, e)
     else:

@@ -22,7 +22,6 @@ from hinfnav.papers.sun2011 import Scenario
 from hinfnav.papers.yang2020 import SUBSYSTEM_OF
 from hinfnav.papers.yang2020 import Scenario as YangScenario
 from hinfnav.sim import simulate_truth
-from hinfnav.sim.nonlinear import simulate_nonlinear_truth
 
 SCENARIOS = [Scenario(duration_s=30.0, rms_window_s=(5.0, 30.0)),
              ShiScenario(duration_s=40.0, rms_window_s=(4.0, 40.0), maneuver_time_s=20.0),
@@ -39,7 +38,7 @@ def scenario_of(name):
 
 def truth_of(sc):
     if isinstance(sc, AttitudeScenario):
-        return simulate_nonlinear_truth(sc.truth_model(), runs=2, seed=3)
+        return simulate_truth(sc.truth_model(), runs=2, seed=3)
     return simulate_truth(sc.truth_model(), runs=2, seed=3)
 
 

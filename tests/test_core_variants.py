@@ -25,7 +25,7 @@ from hinfnav.estimators import (
 )
 from hinfnav.estimators.attitude import AttitudeAEKF, AttitudeASTEKF, AttitudeHuberEKF, AttitudeHuberSTEKF
 from hinfnav.papers.attitude2018 import Scenario
-from hinfnav.sim.nonlinear import simulate_nonlinear_truth
+from hinfnav.sim import simulate_truth
 from hinfnav.systems import LinearMeasurement, StateSpec
 
 BIG = 1e9  # a Huber threshold no whitened residual reaches: every weight is 1
@@ -136,7 +136,7 @@ SC = Scenario(orbits=0.01)
 
 @pytest.fixture(scope="module")
 def truth():
-    return simulate_nonlinear_truth(SC.truth_model(), runs=2, seed=5)
+    return simulate_truth(SC.truth_model(), runs=2, seed=5)
 
 
 @pytest.mark.parametrize("plain, huber", [(AttitudeAEKF, AttitudeHuberEKF), (AttitudeASTEKF, AttitudeHuberSTEKF)])

@@ -517,19 +517,13 @@ def test_bad_form_and_zero_L_are_rejected(scenario):
         design_for_scenario(scenario, 0.05, form="Observer")
 
 
-def test_loose_matrices_are_deprecated_and_give_the_same_design():
-    # issue 23: synthesize takes an UncertainSystem; the seven loose matrices still work for one release, with a
-    # DeprecationWarning, and give the same filter (same data, same solver path: exact equality expected)
-    A, B, C, D, L, H, E = [[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], [[0.2]], [[1.0]]
-    new = synthesize(UncertainSystem(A, B, C, D, L, H, E, dt=0.1))
-    with pytest.warns(DeprecationWarning, match=r"UncertainSystem\(A, B, C, D, L, H, E, dt=T\)"):
-        old = synthesize(A, B, C, D, L, H=H, E=E, dt=0.1)
-    assert old.gamma == new.gamma and np.array_equal(old.A_F, new.A_F) and old.dt == new.dt == 0.1
-    with pytest.warns(DeprecationWarning):
-        assert synthesize(A, B, C, D, L).dt is True  # the old default: discrete, sampling time unspecified
-    with pytest.raises(InputError, match=r"\bdt\b.*system"):
+def test_loose_matrices_are_refused():
+    # 0.3 dropped the loose-matrix form synthesize(A, B, C, D, L, H=, E=, dt=) (CHANGELOG, 0.3.0): the system is
+    # one UncertainSystem, and anything else is refused by name
+    A, B, C, D, L = [[0.5]], [[1.0]], [[1.0]], [[1.0]], [[1.0]]
+    with pytest.raises(TypeError):
+        synthesize(A, B, C, D, L)
+    with pytest.raises(TypeError, match=r"\bdt\b"):
         synthesize(UncertainSystem(A, B, C, D, L), dt=0.1)
-    with pytest.raises(InputError, match="UncertainSystem alone"):
-        synthesize(UncertainSystem(A, B, C, D, L), B)
     with pytest.raises(InputError, match="system must be a hinfnav UncertainSystem"):
         synthesize("plant")

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from hinfnav import InputError, convergence_time, max_error, monte_carlo_summary, rms_error, rms_per_run
-from hinfnav.metrics import by_group, group_rms
+from hinfnav import InputError, monte_carlo_summary, rms_error
+from hinfnav.metrics import by_group, convergence_time, group_rms, max_error, rms_per_run
 from hinfnav.systems import chaser_state_spec
 
 STATE = chaser_state_spec()

@@ -2,10 +2,8 @@
 
 Expected values: the definitions n_steps = round(duration_s / dt) and t_k = k dt (closed form), the
 papers' documented defaults (sun2011: 0.1 s over 1000 s; shi2018: 0.4 s over 1000 s, window 200-1000 s;
-yang2020: h = 0.1 s) and the deprecated name ``window_s`` of shi2018's window (issue 23).
+yang2020: h = 0.1 s) and shi2018's earlier name ``window_s`` refused (removed in 0.3).
 """
-
-import warnings
 
 import numpy as np
 import pytest
@@ -43,27 +41,19 @@ def test_replace_changes_one_setting_and_validates_it_again():
         sc.replace(rms_window_s=5.0)
 
 
-def test_rms_window_is_one_name_and_the_old_shi2018_name_still_works_with_a_warning():
+def test_rms_window_is_one_name():
     assert shi2018.Scenario().rms_window_s == (200.0, 1000.0)  # shi2018's documented window
-    with pytest.warns(DeprecationWarning, match="'window_s' is deprecated, use 'rms_window_s'"):
-        old = shi2018.Scenario(window_s=(100.0, 900.0))
-    assert old.rms_window_s == (100.0, 900.0)
-    with pytest.warns(DeprecationWarning, match="window_s is deprecated"):
-        assert old.window_s == (100.0, 900.0)
-    with pytest.warns(DeprecationWarning):
-        assert old.replace(window_s=(0.0, 500.0)).rms_window_s == (0.0, 500.0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert old.replace(rms_window_s=(0.0, 400.0)).rms_window_s == (0.0, 400.0)  # the new name: no warning
-    with pytest.raises(InputError, match="give 'rms_window_s' only"):
-        shi2018.Scenario(window_s=(0.0, 1.0), rms_window_s=(0.0, 2.0))
+    with pytest.raises(TypeError, match="window_s"):  # its name before issue 23, removed in 0.3
+        shi2018.Scenario(window_s=(100.0, 900.0))
+    with pytest.raises(InputError, match="unknown field 'window_s'"):
+        shi2018.Scenario().replace(window_s=(0.0, 500.0))
     for cls in (sun2011.Scenario, shi2018.Scenario, attitude2018.Scenario):
         sc = cls()
         start, end = sc.rms_window_s
         assert 0 <= start < end <= sc.duration_s
 
 
-def test_the_adaptive_filters_memory_is_memory_steps_and_window_still_works_with_a_warning():
+def test_the_adaptive_filters_memory_is_memory_steps():
     # issue 23: ``window`` of the rate-adaptive filters is m, a number of steps, not a (start, end) window
     from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
     from hinfnav.papers.attitude2018.filters import build_aaekf
@@ -71,7 +61,7 @@ def test_the_adaptive_filters_memory_is_memory_steps_and_window_still_works_with
     sc = AttitudeScenario(orbits=0.25)
     assert build_aaekf(sc).memory_steps == 60  # paper 002's default m (constants.DEFAULT_AA)
     assert build_aaekf(sc, memory_steps=7).memory_steps == 7
-    with pytest.warns(DeprecationWarning, match="'window' is deprecated, use 'memory_steps'"):
-        assert build_aaekf(sc, window=9).memory_steps == 9
+    with pytest.raises(TypeError, match="window"):  # its name before issue 23, removed in 0.3
+        build_aaekf(sc, window=9)
     with pytest.raises(InputError, match="memory_steps"):
         build_aaekf(sc, memory_steps=0)

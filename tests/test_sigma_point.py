@@ -31,7 +31,7 @@ from hinfnav.estimators.sigma_point import merwe_weights
 from hinfnav.papers import shi2018, sun2011
 from hinfnav.papers.attitude2018 import Scenario as AttitudeScenario
 from hinfnav.papers.attitude2018 import build_aekf
-from hinfnav.sim.nonlinear import simulate_nonlinear_truth
+from hinfnav.sim import simulate_truth
 from hinfnav.systems import (
     ConstantTurn,
     ConvertedRangeBearing,
@@ -218,7 +218,7 @@ def test_quaternion_states_through_error_coordinates():
     # α = 1e-2 must agree with the AEKF far inside the estimation error (left: O(α²) terms and the AEKF's Taylor
     # e^{FΔt} against the Jacobian of the mean prediction); with α = 1 it must estimate as well (RMS within 1 %).
     sc = AttitudeScenario(orbits=0.05)  # 293 steps of 1 s
-    truth = simulate_nonlinear_truth(sc.truth_model(), runs=2, seed=11)
+    truth = simulate_truth(sc.truth_model(), runs=2, seed=11)
     aekf = build_aekf(sc)
     ref = aekf.estimate(truth.y, truth.u, sc.xhat0)
     spec = sc.system().state

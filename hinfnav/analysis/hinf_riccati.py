@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.validation import as_int_at_least, as_matrix, as_nonnegative, as_positive
 
-__all__ = ["MAX_ITER", "max_admissible_theta", "steady_state_hinf"]
+__all__ = ["max_admissible_theta", "steady_state_hinf"]
 
 #: Default cap on recursion steps. The doubling covers ``2^j - 1`` steps in
 #: ``j`` matrix updates, so 2^60 costs about 60 updates. The cap must not decide

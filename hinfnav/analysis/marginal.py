@@ -60,7 +60,7 @@ from scipy.linalg import orth
 from ..core.exceptions import InputError, UnstablePlantError
 from ..core.linalg import spectral_radius
 
-__all__ = ["ReadPart", "read_part", "check_read_part", "augmented_error_coordinates", "unstable_states",
+__all__ = ["ReadPart", "read_part", "check_read_part", "augmented_error_coordinates",
            "simplex_cells"]
 
 

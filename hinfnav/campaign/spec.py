@@ -67,7 +67,7 @@ from ..estimators.registry import estimator_entry, fit_reason, registered_estima
 from ..noise import NOISE_NAMES
 from .registry import build_scenario, condition_parameters, scenario_entry, scenario_parameters
 
-__all__ = ["Campaign", "Cell", "load_campaign", "canonical", "digest", "LIMITS", "FULL_CHECK", "STEPS_PER_SECOND"]
+__all__ = ["Campaign", "Cell", "load_campaign", "canonical", "digest", "LIMITS"]
 
 #: Top-level fields of a campaign (TOML or dict).
 FIELDS = ("name", "runs", "seed", "batch_size", "grid", "windows", "tol", "estimator_options", "share_truth")

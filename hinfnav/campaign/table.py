@@ -30,7 +30,7 @@ from typing import Any
 
 import pandas as pd
 
-__all__ = ["results_table", "STATISTICS", "COLUMNS"]
+__all__ = ["results_table", "STATISTICS"]
 
 #: Statistics per window and quantity, with the key of the cell JSON they come from.
 STATISTICS = (("rms_pooled", "pooled"), ("rms_ci95_low", "rms_ci95_low"), ("rms_ci95_high", "rms_ci95_high"),

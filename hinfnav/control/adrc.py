@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_matrix, as_nonnegative, as_positive
 
-__all__ = ["fal", "NonlinearPID", "DragFreeADRC", "INTEGRALS", "saturate"]
+__all__ = ["fal", "NonlinearPID", "DragFreeADRC", "saturate"]
 
 #: Readings of the NLPID integral e_i: the printed sum over steps, h times it, none.
 INTEGRALS = ("printed", "dt", "off")

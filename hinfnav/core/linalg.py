@@ -21,7 +21,7 @@ from .exceptions import InputError
 from .validation import as_choice, as_matrix, as_positive
 
 __all__ = ["spectral_radius", "sym", "as_covariance", "discretize", "inv_spd", "matmul_shared", "congruence",
-           "joseph_covariance", "SERIAL_PRODUCT_SIZE", "ELEMENTWISE_SIZE", "inv_spd_cholesky"]
+           "joseph_covariance", "SERIAL_PRODUCT_SIZE", "inv_spd_cholesky"]
 
 
 def spectral_radius(A):

@@ -31,10 +31,8 @@ from typing import Any
 from .exceptions import InputError
 from .validation import as_path
 
-__all__ = ["read_toml", "check_schema", "KINDS"]
+__all__ = ["read_toml", "check_schema"]
 
-#: The value kinds a schema may name (besides a dict for a table and [dict] for an array of tables).
-KINDS = ("number", "integer", "bool", "string", "matrix", "any")
 
 _BOMS = {b"\xef\xbb\xbf": "UTF-8", b"\xff\xfe": "UTF-16 (little-endian)", b"\xfe\xff": "UTF-16 (big-endian)"}
 

@@ -37,7 +37,7 @@ from ..systems.polytopic import MATRIX_KEYS, PolytopicSystem
 from ..systems.uncertain import UncertainSystem
 from .result import COVERS_NOMINAL, COVERS_NORM_BOUNDED, DesignResult
 
-__all__ = ["FORMAT", "system_fingerprint", "content_fingerprint", "design_to_dict", "design_from_dict", "save_design", "load_design",
+__all__ = ["system_fingerprint", "content_fingerprint", "save_design", "load_design",
            "check_design_system", "check_design_path"]
 
 #: Identifier and version of the file format.

@@ -447,9 +447,7 @@ class _Designer:
 _DOC_PARAMS = """
     system : UncertainSystem
         The plant ψ_d (9)–(11) (no H, E: nominal), A Schur stable for every
-        admissible F; its ``dt`` (s) is the result's. Deprecated until 0.3:
-        the loose matrices ``A, B, C, D, L[, H, E]`` with ``dt=``, as in
-        :func:`hinfnav.design.synthesize`.
+        admissible F; its ``dt`` (s) is the result's.
     structure : {"full", "diagonal"}, optional
         Whether F is any contraction or diagonal (balancing, default samples),
         as in :func:`hinfnav.design.synthesize`.
@@ -468,10 +466,10 @@ _DOC_PARAMS = """
 """
 
 
-def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float | None = None, structure: str = "full",
+def synthesize_mixed(system: UncertainSystem, *, gamma: float | None = None, structure: str = "full",
                      uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                      seed: int | np.random.Generator = 0, lyapunov: str = "extended", options: SolverOptions | None = None,
-                     solver: str | None = None, **legacy: Any) -> DesignResult:
+                     solver: str | None = None) -> DesignResult:
     """Robust mixed H2/H∞ filter: minimize the certified worst-case H2 norm ν subject to the H∞ bound γ.
 
     Parameters
@@ -506,18 +504,18 @@ def synthesize_mixed(system: UncertainSystem, *matrices: ArrayLike, gamma: float
     with Q = BBᵀ, R = DDᵀ): the filter (12) is a predictor (z_f(k) uses
     y up to k − 1). The test suite checks this to 1e-4.
     """
-    system, dt = system_argument("synthesize_mixed", system, matrices, legacy)
+    system, dt = system_argument("synthesize_mixed", system)
     designer = _Designer(system, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov, options, solver)
     res = designer.design(gamma)
     return dataclasses.replace(res, total_time_s=time.perf_counter() - designer.t_start)
 
 
-def mixed_front(system: UncertainSystem, *matrices: ArrayLike, gammas: Sequence[float], include_h2: bool = True,
+def mixed_front(system: UncertainSystem, *, gammas: Sequence[float], include_h2: bool = True,
                 structure: str = "full", uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None,
                 n_random_samples: int = 4, seed: int | np.random.Generator = 0, lyapunov: str = "extended",
                 options: SolverOptions | None = None, solver: str | None = None, gamma_star: float | None = None,
                 hinf_result: DesignResult | None = None,
-                progress: Callable[[DesignResult], object] | None = None, **legacy: Any) -> MixedFront:
+                progress: Callable[[DesignResult], object] | None = None) -> MixedFront:
     """Certified mixed designs along a γ grid (one compiled problem, re-solved per γ).
 
     Parameters
@@ -541,7 +539,7 @@ def mixed_front(system: UncertainSystem, *matrices: ArrayLike, gammas: Sequence[
     g = np.sort(np.array([as_positive("gammas entry", v) for v in np.ravel(gammas)], dtype=float))
     if g.size == 0:
         raise InputError("gammas must contain at least one γ")
-    system, dt = system_argument("mixed_front", system, matrices, legacy)
+    system, dt = system_argument("mixed_front", system)
     designer = _Designer(system, dt, structure, uncertainty_samples, n_random_samples, seed, lyapunov, options, solver)
     results = []
     for gamma in g:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -18,8 +17,6 @@ if TYPE_CHECKING:
 
 __all__ = ["DesignResult", "COVERS_NORM_BOUNDED", "COVERS_NOMINAL"]
 
-#: Attribute names before issue 23 (Sun 2011's δ grid) -> the generic names; kept until 0.3, warned.
-_RENAMED = {"delta_bar": "uncertainty_bound", "deltas": "sample_values", "worst_delta": "worst_value"}
 
 #: What the certificate of a norm-bounded design (LMI (20), one quadratic Lyapunov function) covers.
 COVERS_NORM_BOUNDED = "every time-varying F(k) with FᵀF ≤ I (one quadratic Lyapunov function)"
@@ -176,15 +173,6 @@ class DesignResult:
     def worst_value(self) -> float | None:
         """Parameter value of the worst sample (None when the samples carry no values)."""
         return None if self.sample_values is None else float(self.sample_values[self.worst_sample])
-
-    def __getattr__(self, name: str) -> object:
-        """The earlier, Sun-2011 attribute names (``delta_bar``, ``deltas``, ``worst_delta``), warned until 0.3."""
-        new = _RENAMED.get(name)
-        if new is None:
-            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-        warnings.warn(f"DesignResult.{name} is deprecated and will be removed in 0.3; use .{new}",
-                      DeprecationWarning, stacklevel=2)
-        return getattr(self, new)
 
     def error_system(self, system: UncertainSystem | None = None, F: ArrayLike | None = None) -> control.StateSpace:
         """Error system (13)–(15) of this filter on a norm-bounded ``system`` (default its own) at uncertainty F."""

@@ -214,10 +214,10 @@ def _best_sampled(run):
 
 
 
-def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "full",
+def synthesize(system: UncertainSystem, *, structure: str = "full",
                uncertainty_samples: SampleSet | Sequence[ArrayLike | None] | None = None, n_random_samples: int = 4,
                seed: int | np.random.Generator = 0, form: str = "general", options: SolverOptions | None = None,
-               solver: str | None = None, **legacy: Any) -> DesignResult:
+               solver: str | None = None) -> DesignResult:
     """Robust H∞ filter for ψ_d (9)–(11) by Corollary 1, certified.
 
     Parameters
@@ -227,10 +227,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
         ``y = C x + D v``, ``z = L x``, ``FᵀF ≤ I`` (no H, E, or zero ones:
         the nominal H∞ filter). A must be Schur stable for every admissible
         F. Its ``dt`` (s) is the sampling time of the result's
-        :meth:`DesignResult.statespace`. Deprecated until 0.3: the loose
-        matrices ``A, B, C, D, L[, H, E]`` with ``dt=`` (float, or True:
-        discrete, unspecified), with a :class:`DeprecationWarning`
-        (:func:`hinfnav.design.arguments.system_argument`).
+        :meth:`DesignResult.statespace`.
     structure : {"full", "diagonal"}, optional
         Whether F is any contraction or diagonal (as in the paper, Section 4);
         decides how H and E are balanced (see :func:`prepare_uncertainty`)
@@ -355,7 +352,7 @@ def synthesize(system: UncertainSystem, *matrices: ArrayLike, structure: str = "
     estimate).
     """
     t_start = time.perf_counter()
-    system, dt_value = system_argument("synthesize", system, matrices, legacy)
+    system, dt_value = system_argument("synthesize", system)
     structure = as_choice("structure", structure, ("full", "diagonal"))
     n_random_samples = as_int_at_least("n_random_samples", n_random_samples, 0)
     seed = as_seed("seed", seed)

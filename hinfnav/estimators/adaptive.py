@@ -46,7 +46,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core.exceptions import InputError
 from ..core.linalg import matmul_shared
-from ..core.deprecation import renamed_keywords
 from ..core.validation import as_int_at_least, as_nonnegative, as_positive
 
 if TYPE_CHECKING:
@@ -61,7 +60,6 @@ __all__ = [
     "fading_factors",
     "innovation_moment",
     "input_rate",
-    "per_run_parameter",
     "rate_adapted_density",
 ]
 
@@ -335,8 +333,7 @@ class RateAdaptive:
     Parameters
     ----------
     memory_steps : int
-        m, the number of steps over which the rate is estimated (≥ 1). Called
-        ``window`` before issue 23 (still accepted, with a DeprecationWarning).
+        m, the number of steps over which the rate is estimated (≥ 1).
     epsilon : float or array_like, shape (runs,)
         Compression factor ε, s per unit of the adapted state (> 0); one
         value per run batches an ε sweep.
@@ -353,7 +350,6 @@ class RateAdaptive:
     data_dependent_covariance = True
     defers_prior = True
 
-    @renamed_keywords(window="memory_steps")
     def __init__(self, *args: Any, memory_steps: int = 60, epsilon: float = 1.0, floor: float = 1.0,
                  states: Any = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)

@@ -71,12 +71,10 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_estimator_inputs", "fill_missing", "history_keys",
-           "store_diagnostics", "MISSING", "PHASES", "READING_LIMIT", "KNOWN_DIAGNOSTICS", "available_channels", "initial_estimates"]
+           "store_diagnostics", "READING_LIMIT", "KNOWN_DIAGNOSTICS", "available_channels", "initial_estimates"]
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
-#: Where a :class:`FilterState` is in the step cycle: "prior" (expects ``update``), "posterior" (expects ``predict``).
-PHASES = ("prior", "posterior")
 
 
 def available_channels(y):

@@ -70,7 +70,7 @@ from ..systems.measurements import MeasurementModel
 from .compiled_diagnostics import NIS_DIAGNOSTICS, nis_diagnostics
 from .compiled_nonlinear import model_status, run_model_kernel, uses_model_route
 
-__all__ = ["BACKENDS", "BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status", "numba_available",
+__all__ = ["BACKEND_VARIABLE", "KERNELS", "default_backend", "kernel_status",
            "run_compiled", "select_backend", "use_backend", "why_numpy"]
 
 #: What ``Estimator.estimate(backend=...)`` accepts.

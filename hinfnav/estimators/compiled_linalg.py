@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 __all__ = ["chol", "chol_solve", "chol_to", "eye_minus", "finite", "inv_to", "lin", "maxabs", "mm", "mm_to", "mmt",
-           "mmt_sym_to", "mmt_to", "mv", "mv_to", "spd_inv", "sym", "tri_inv"]
+           "mmt_sym_to", "mmt_to", "mv", "mv_to", "sym", "tri_inv"]
 
 @njit(cache=True, error_model="numpy")
 def mm(A, B):

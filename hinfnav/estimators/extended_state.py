@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["ExtendedStateKalmanFilter", "theta_star", "check_steady_tol", "predicted_increment", "CHECK_EVERY"]
+__all__ = ["ExtendedStateKalmanFilter", "theta_star", "check_steady_tol", "CHECK_EVERY"]
 
 def theta_star(Q1, P0):
     """θ* = √(tr Q₁,₀ / tr P₀) of Algorithm 1; an :class:`InputError` if it is 0."""

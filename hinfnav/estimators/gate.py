@@ -52,12 +52,10 @@ from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
 from .correction import drop_missing
 
-__all__ = ["ChiSquareGate", "GateOption", "GATE_KEYS", "RECOVERIES", "gate_report", "gated"]
+__all__ = ["ChiSquareGate", "GateOption", "gate_report", "gated"]
 
 #: Recovery policies (see the module docstring).
 RECOVERIES = ("inflate", "reacquire", None)
-#: The diagnostics a gate adds to every step.
-GATE_KEYS = ("gate_rejected", "gate_distance", "gate_recovery", "gate_count")
 
 
 @dataclass(frozen=True)

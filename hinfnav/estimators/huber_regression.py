@@ -23,7 +23,7 @@ iterations and the same weights (:data:`BETAS`, :data:`BACKTRACK`,
 
 import numpy as np
 
-__all__ = ["BACKTRACK", "BETAS", "huber_cost", "huber_weights", "minimise", "normal_matrix", "covariance", "mv", "mtv"]
+__all__ = ["BACKTRACK", "BETAS", "huber_cost", "huber_weights", "minimise", "normal_matrix", "covariance", "mv"]
 
 def _chol(A, pivot_tol=1e-12):
     """Cholesky factors of a batch of symmetric matrices; ``(L, ok)``.

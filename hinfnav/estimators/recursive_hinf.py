@@ -71,7 +71,7 @@ if TYPE_CHECKING:
     from ..systems.linear import LinearSystem
     from ..systems.measurements import MeasurementModel
 
-__all__ = ["RecursiveHInfinityFilter", "ExtendedHInfinityFilter", "ON_VIOLATION", "EXTENDED_ON_VIOLATION",
+__all__ = ["RecursiveHInfinityFilter", "ExtendedHInfinityFilter",
            "STEADY_TOL"]
 
 #: What the filter does when the existence condition fails.

@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from importlib import metadata
 from typing import TYPE_CHECKING, Any
 
-from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..core.validation import as_choice
 from .sqrt import FORMS, square_root
@@ -35,8 +34,9 @@ from .strategies import as_strategy, compose
 if TYPE_CHECKING:
     from .base import Estimator
 
-__all__ = ["register_estimator", "register_composition", "build_estimator", "registered_estimators", "estimator_entry", "load_providers",
-           "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason", "ERROR_FORMS", "CORE_OPTIONS"]
+__all__ = ["register_estimator", "register_composition", "build_estimator", "registered_estimators",
+           "estimator_entry", "load_providers", "providers", "PROVIDER_GROUP", "Requires", "Offers", "fit_reason",
+           "CORE_OPTIONS"]
 
 #: Options every estimator takes whatever its builder (issue 36): applied by :func:`build_estimator` to the built
 #: estimator through the :class:`~hinfnav.estimators.base.Estimator` contract (``missing``, its property).
@@ -222,7 +222,6 @@ def register_composition(name: str, base: str, *, correction: Any = None, fading
                              composed=(base, correction, fading))
 
 
-@scenario_moved("name", "scenario", was=str)
 def fit_reason(scenario: Any, name: str) -> str | None:
     """Why the estimator ``name`` does not fit ``scenario`` (None: it fits).
 
@@ -261,7 +260,6 @@ def estimator_entry(name: str) -> _Entry:
     return _REGISTRY[name]
 
 
-@scenario_moved("name", "scenario", was=str)
 def build_estimator(scenario: Any, name: str, *, covariance_form: str = "joseph", correction: Any = None,
                     fading: Any = None, **options: Any) -> Estimator:
     """Build the estimator registered as ``name`` for ``scenario``.

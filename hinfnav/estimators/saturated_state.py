@@ -25,7 +25,7 @@ from .correction import drop_missing, joseph_covariance, kalman_gain
 from .extended_state import ExtendedStateKalmanFilter, check_steady_tol
 from .steady import freeze_gain
 
-__all__ = ["SaturatedExtendedStateFilter", "FusedExtendedStateFilter", "MODES", "FUSED_COVARIANCES"]
+__all__ = ["SaturatedExtendedStateFilter", "FusedExtendedStateFilter"]
 
 #: How Algorithm 2 treats a clipped reading: truncated-normal update (L1), skip the update (L3), never clipped (L2).
 MODES = ("truncated", "skip", "ideal")

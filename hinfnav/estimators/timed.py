@@ -36,7 +36,7 @@ from .sigma_point import SigmaPointFilter
 from .smoothers import SmoothedHistory, filter_record, rts_smooth
 from .sqrt import factor
 
-__all__ = ["estimate_timed", "smooth_timed", "step_filter"]
+__all__ = ["estimate_timed", "smooth_timed"]
 
 
 def step_filter(estimator: Estimator, system: Any) -> Estimator:

@@ -78,7 +78,7 @@ if TYPE_CHECKING:
     from .base import FilterState
 
 __all__ = ["DataDependentCorrection", "StudentTCorrection", "StudentTFilter", "NoiseAdaptiveCorrection",
-           "NoiseAdaptiveFilter", "used_rows", "relative_change"]
+           "NoiseAdaptiveFilter", "relative_change"]
 
 
 def _swap(M):

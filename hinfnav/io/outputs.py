@@ -29,7 +29,7 @@ import numpy as np
 from ..core.exceptions import InputError
 
 __all__ = ["dumps_strict", "MARKER", "check_output_dir", "atomic_output_dir", "output_lock", "lock_path", "to_json", "atomic_write_text",
-           "write_json", "check_writable_folder"]
+           "write_json"]
 
 #: File that marks a folder as written by hinfnav (so it may be replaced).
 MARKER = ".hinfnav-output"

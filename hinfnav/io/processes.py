@@ -36,7 +36,7 @@ from threadpoolctl import threadpool_limits
 
 from ..core.exceptions import InputError
 
-__all__ = ["PrefixedLines", "one_blas_thread", "run_jobs", "check_jobs", "cpu_seconds"]
+__all__ = ["PrefixedLines"]
 
 
 class PrefixedLines(io.TextIOBase):

@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike
 from ..analysis.certificates import schur_gamma
 from .solve import solve_once_gamma
 
-__all__ = ["continuous_brl_matrix", "continuous_pd_matrix", "robust_hinf_continuous", "certify_continuous",
+__all__ = ["robust_hinf_continuous", "certify_continuous",
            "solve_continuous_observer"]
 
 

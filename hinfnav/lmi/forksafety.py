@@ -16,7 +16,7 @@ import os
 
 from ..core.exceptions import SynthesisError
 
-__all__ = ["note_solve", "FORK_UNSAFE_SOLVERS"]
+__all__ = ["note_solve"]
 
 #: Solvers whose first solve in a child forked after a solve in the parent can hang.
 FORK_UNSAFE_SOLVERS = ("CLARABEL",)

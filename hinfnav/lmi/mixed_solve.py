@@ -25,7 +25,7 @@ from .blocks import lmi20_matrix
 from .mixed_blocks import extended_h2_matrix, robust_extended_hinf_negative, h2_trace_matrix, slack_products
 from .solve import run_solver
 
-__all__ = ["LYAPUNOV", "MixedSolution", "MixedProblem"]
+__all__ = ["LYAPUNOV", "MixedProblem"]
 
 #: How the H2 and H∞ conditions share their Lyapunov matrices.
 LYAPUNOV = ("extended", "common")

@@ -31,7 +31,7 @@ from .blocks import error_system_matrices
 from .mixed_blocks import extended_h2_matrix
 from .solve import LMIProblem
 
-__all__ = ["H2Certificate", "robust_h2_bound"]
+__all__ = ["robust_h2_bound"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -33,9 +33,9 @@ if TYPE_CHECKING:
     from ..analysis.structure import Block
     from .conditioning import Prepared
 
-__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SOLVER_ERRORS", "SolverOptions", "Solution", "LMIProblem",
-           "run_solver", "watch_solves", "SolveWatch", "SCS_BUDGET_S", "solve_once", "solve_once_gamma", "lmi20_problem",
-           "solve_lmi", "BLOCK_RETRY"]
+__all__ = ["SOLVERS", "METHODS", "INFEASIBLE", "SolverOptions", "Solution", "LMIProblem", "run_solver",
+           "watch_solves", "SolveWatch", "SCS_BUDGET_S", "solve_once", "solve_once_gamma", "lmi20_problem", "solve_lmi",
+           "BLOCK_RETRY"]
 
 #: Solvers the synthesis accepts (cvxpy names).
 SOLVERS = ("CLARABEL", "CVXOPT", "SCS")

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from ..sim.truth import Truth
     from ..systems.state import StateSpec
 
-__all__ = ["WindowStatistics", "StatisticsAccumulator", "StatisticsSink", "group_summary", "rms_interval", "add_batch",
+__all__ = ["WindowStatistics", "StatisticsAccumulator", "StatisticsSink", "group_summary", "rms_interval",
            "GATE_KEY"]
 
 #: The diagnostic of a gated filter (:mod:`hinfnav.estimators.gate`) whose rejections a cell counts.

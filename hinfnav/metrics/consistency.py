@@ -449,8 +449,8 @@ def consistency(result: SimulationResult | ArrayLike, xhat0: ArrayLike | None = 
         A simulation result with its covariance ``P`` (a kept diagonal only,
         ``keep_covariance="diagonal"``, gives no NEES) and, for the NIS, the
         diagnostics :data:`NIS_KEYS` (``hinfnav.simulate`` keeps them;
-        ``simulate_nonlinear`` when asked: ``keep_covariance=True,
-        diagnostics=NIS_KEYS``); or the true states x, with ``xhat`` and ``P``.
+        unless told ``keep_covariance=False`` or
+        ``diagnostics=False``); or the true states x, with ``xhat`` and ``P``.
     xhat0 : array_like, shape (n_stored,) or (runs, n_stored), optional
         The filters' initial estimate(s) (for the initial error scale; default
         ``result.xhat0``).

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from ..io.outputs import atomic_write_text, to_json
 
-__all__ = ["CLAIM_COLUMNS", "claims_rows", "format_claims_table", "write_claims_table"]
+__all__ = ["write_claims_table"]
 
 #: The columns, in order.
 CLAIM_COLUMNS = ("id", "figure", "claim", "quote", "quote_en", "statistic", "number", "paper", "verdict")

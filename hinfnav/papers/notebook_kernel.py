@@ -32,7 +32,7 @@ from jupyter_client.manager import AsyncKernelManager
 from jupyter_client.asynchronous import AsyncKernelClient
 from traitlets import DottedObjectName, Type
 
-__all__ = ["POLL_SLICE_S", "KernelManager", "SlicedPollChannel", "SlicedPollKernelClient"]
+__all__ = ["KernelManager", "SlicedPollKernelClient"]
 
 #: Longest a single poll of the shell socket waits before it looks again (s): the most a lost
 #: readiness edge can cost.

@@ -19,7 +19,7 @@ from tqdm import tqdm
 from ..core.exceptions import HinfnavError, InputError
 from ..io.progress import bar_disabled
 
-__all__ = ["CELL_TIMEOUT_S", "CROSS_PAPER", "NOTEBOOK_DIR", "NotebookStallError", "check_notebooks",
+__all__ = ["CROSS_PAPER", "NOTEBOOK_DIR", "NotebookStallError", "check_notebooks",
            "execute_notebook", "run_notebooks", "sequence_parameter"]
 
 #: The repository's notebooks (next to the package in a source checkout).

@@ -31,15 +31,11 @@ if TYPE_CHECKING:
     from ..design.result import DesignResult
 
 __all__ = [
-    "GAIN_LABEL",
     "plot_gamma_curve",
     "plot_sigma",
     "plot_worst_case_over_delta",
     "plot_filter_matrices",
 ]
-
-#: Axis label of the error-system gains.
-GAIN_LABEL = "gain of error system Ψ (m or m/s per unit noise)"
 
 
 def plot_gamma_curve(sweep: Any, *, ax: Axes, sampled: bool = True, linthresh: float = 0.01) -> list[Artist]:

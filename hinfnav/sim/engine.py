@@ -1,8 +1,7 @@
 """The one Monte Carlo engine: truths batch by batch, estimators on them, results into a sink.
 
 :func:`run_monte_carlo` is the loop every Monte Carlo of the package goes
-through (:func:`~hinfnav.sim.simulate`, :func:`~hinfnav.sim.simulate_nonlinear`,
-:func:`~hinfnav.sim.simulate_closed_loop`,
+through (:func:`~hinfnav.sim.simulate`, :func:`~hinfnav.sim.simulate_closed_loop`,
 :func:`hinfnav.metrics.monte_carlo_statistics` and a campaign cell)::
 
     for each batch of runs [start, start + n):
@@ -46,7 +45,6 @@ of one batch, whatever the runs).
 
 from __future__ import annotations
 
-import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
@@ -56,7 +54,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 from tqdm import tqdm
 
-from ..core.deprecation import scenario_moved
 from ..core.exceptions import InputError
 from ..core.protocols import CampaignTruthScenario, OwnTruthScenario
 from ..io.progress import bar_disabled
@@ -73,8 +70,8 @@ if TYPE_CHECKING:
     from ..systems.measurements import MeasurementModel
 
 __all__ = ["Sink", "HistorySink", "run_monte_carlo", "truth_batch", "truth_batches", "estimate_on_truth",
-           "closed_loop_batch", "truth_runs", "resolve_estimator", "resolve_estimators", "check_measurement_match", "plain_seed",
-           "results_from_parts", "batch_result"]
+           "closed_loop_batch", "resolve_estimator", "resolve_estimators", "check_measurement_match",
+           "batch_result"]
 
 
 class Sink:
@@ -107,13 +104,6 @@ def plain_seed(seed: int | np.random.SeedSequence | np.random.Generator) -> int 
     return seed
 
 
-def _names_estimators(value: Any) -> bool:
-    """Whether ``value`` is what came first in ``resolve_estimator(s)``'s earlier order: estimators, never a scenario."""
-    design = getattr(sys.modules.get("hinfnav.design.result"), "DesignResult", ())  # no design without its module
-    return isinstance(value, (str, Estimator, Mapping, Sequence, design))
-
-
-@scenario_moved("estimator", "scenario", was=_names_estimators)
 def resolve_estimator(scenario: Any, estimator: str | Estimator | DesignResult) -> Estimator:
     """An :class:`Estimator` (or an object with its ``estimate`` and ``measurement``): given, registered under a name for ``scenario``, or built from a design.
 
@@ -143,7 +133,6 @@ def _estimator_like(obj: Any) -> bool:
     return isinstance(obj, Estimator) or (callable(getattr(obj, "estimate", None)) and hasattr(obj, "measurement"))
 
 
-@scenario_moved("estimators", "scenario", was=_names_estimators)
 def resolve_estimators(scenario: Any, estimators: Any) -> dict[str, Estimator]:
     """Name → Estimator from one estimator, a sequence of them, or a mapping name → estimator (names unique)."""
     if isinstance(estimators, Mapping):

@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from .truth import Truth
 
 
-__all__ = ["SimulationResult", "available_memory_bytes", "history_bytes", "check_history_memory",
+__all__ = ["SimulationResult", "history_bytes", "check_history_memory",
            "check_measurement_match", "run_estimator", "simulate", "simulate_batches", "resolve_estimator", "NIS_KEYS"]
 
 #: The diagnostics :func:`simulate` keeps by default: innovation and its covariance S

@@ -12,38 +12,23 @@ length ``duration_s`` (s); it inherits
 * :meth:`Scenario.checked_window` — the validation of the RMS window
   ``rms_window_s = (start, end)`` (s), ``0 ≤ start < end ≤ duration_s``, the one
   name every scenario gives the window of its RMS error statistic.
-
-A field renamed in a release keeps working for one release through
-:func:`renamed_fields` (the old keyword and attribute warn with a
-:class:`DeprecationWarning` and reach the new field).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
-import warnings
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..core.exceptions import InputError
-from ..core.deprecation import translate_keywords
 
-__all__ = ["Scenario", "renamed_fields"]
+__all__ = ["Scenario"]
 
 
 class Scenario:
-    """Base of the scenarios (subclasses are frozen dataclasses defining ``dt`` and ``duration_s``, s).
-
-    Attributes
-    ----------
-    RENAMED : dict of str to str
-        Deprecated keyword → current field (set through :func:`renamed_fields`).
-    """
-
-    RENAMED: ClassVar[dict[str, str]] = {}
+    """Base of the scenarios (subclasses are frozen dataclasses defining ``dt`` and ``duration_s``, s)."""
 
     dt: float
     duration_s: float
@@ -56,7 +41,6 @@ class Scenario:
         InputError
             A keyword that is not a field of this scenario (the message names it and lists the fields).
         """
-        changes = _translate(type(self), changes)
         fields = [f.name for f in dataclasses.fields(self) if f.init]
         unknown = [k for k in changes if k not in fields]
         if unknown:
@@ -91,37 +75,3 @@ class Scenario:
             raise InputError(f"{name} must satisfy 0 <= start < end <= duration_s = {self.duration_s}; "
                              f"got ({start}, {end})")
         return start, end
-
-
-def _translate(cls: type, changes: dict[str, Any]) -> dict[str, Any]:
-    """``changes`` with deprecated keywords of ``cls`` renamed (each with a DeprecationWarning)."""
-    return translate_keywords(cls.__name__, cls.RENAMED, changes, stacklevel=4)
-
-
-def renamed_fields(**renamed: str):
-    """Class decorator (above ``@dataclass``): deprecated field names ``old=new`` kept working for one release.
-
-    The constructor and :meth:`Scenario.replace` accept ``old=`` and the
-    attribute ``scenario.old`` reads ``scenario.new``, each with a
-    :class:`DeprecationWarning`.
-    """
-
-    def wrap(cls):
-        cls.RENAMED = {**cls.RENAMED, **renamed}
-        init = cls.__init__
-
-        @functools.wraps(init)
-        def __init__(self, *args, **kwargs):
-            init(self, *args, **_translate(cls, kwargs))
-
-        cls.__init__ = __init__
-        for old, new in renamed.items():
-            def read(self, old=old, new=new):
-                warnings.warn(f"{type(self).__name__}.{old} is deprecated, use .{new}", DeprecationWarning,
-                              stacklevel=2)
-                return getattr(self, new)
-
-            setattr(cls, old, property(read, doc=f"Deprecated name of :attr:`{new}`."))
-        return cls
-
-    return wrap

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from ..noise import NoiseModel
 
 
-__all__ = ["TruthModel", "Truth", "child_rngs", "dispersion_rngs", "DISPERSION_TAG", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
+__all__ = ["TruthModel", "Truth", "child_rngs", "dispersion_rngs", "noise_models", "draw_noise", "simulate_truth", "scenario_truth_model"]
 
 
 @dataclass(frozen=True, eq=False)

@@ -51,7 +51,6 @@ __all__ = [
     "attitude_state_spec",
     "cross",
     "cross_matrix",
-    "euler321_from_matrix",
     "euler321_from_quat",
     "omega_matrix",
     "quat_conjugate",

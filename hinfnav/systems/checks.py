@@ -39,8 +39,6 @@ __all__ = [
     "CheckedModel",
     "call_model",
     "check_jacobian_against_differences",
-    "first_call_memo",
-    "is_user_class",
     "wrap_user_methods",
 ]
 

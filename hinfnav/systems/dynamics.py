@@ -50,7 +50,6 @@ __all__ = [
     "ConstantTurn",
     "constant_turn_state_spec",
     "finite_difference_jacobian",
-    "rk4_step",
     "MAX_SUBSTEPS",
 ]
 

@@ -38,7 +38,7 @@ from .continuous import ContinuousPolytope
 from .polytopic import MATRIX_KEYS, PolytopicSystem
 from .uncertain import UncertainSystem
 
-__all__ = ["read_system_file", "SYSTEM_SCHEMA", "UNCERTAINTY_KEYS"]
+__all__ = ["read_system_file", "SYSTEM_SCHEMA"]
 
 #: Every key a system file may hold, with its kind (:func:`hinfnav.core.tomlfile.check_schema`); any other key, at
 #: any level, is refused naming it. A new key is one line here (and its use in :func:`read_system_file`).

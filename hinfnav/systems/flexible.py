@@ -31,10 +31,7 @@ from .parametric import polytope_from_parameters
 from .polytopic import PolytopicSystem
 from .uncertain import UncertainSystem
 
-__all__ = ["flexible_attitude_matrices", "flexible_attitude", "flexible_attitude_closed_loop", "STATE_NAMES"]
-
-#: Names of the four states.
-STATE_NAMES = ("θ (attitude)", "ω (rate)", "η (mode)", "η̇ (modal rate)")
+__all__ = ["flexible_attitude_matrices", "flexible_attitude", "flexible_attitude_closed_loop"]
 
 
 def flexible_attitude_matrices(freq_hz: float, damping: float, *, J: float = 1.0, phi: float = 0.5,

@@ -7,7 +7,7 @@ with what a campaign needs:
 * ``truth_model(hold)``: the rigid body under T_d(t) with the attitude-hold law;
 * no ``campaign_truth`` of its own: the campaign runner steps that truth
   (:meth:`~hinfnav.systems.attitude.AttitudeSystem.step`, RK4) by
-  :func:`~hinfnav.sim.nonlinear.simulate_nonlinear_truth`, the star-sensor noise
+  :func:`~hinfnav.sim.simulate_truth`, the star-sensor noise
   the campaign's ``noise`` (the truth has no process noise: T_d is given);
 * ``bound_problem(conditions, noise)``: the posterior Cramér–Rao bound in the
   error coordinates (δθ, δω) of an estimator that knows T_d(t), the hold law

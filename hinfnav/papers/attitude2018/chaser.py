@@ -28,9 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
-from ...core.deprecation import renamed_keywords
 from ...core.validation import as_choice, as_int_at_least
 from ...estimators.augmented import (
     AugmentedInputAdaptiveKF,
@@ -48,13 +46,8 @@ from ..sun2011.scenario import Scenario as ChaserScenario
 
 __all__ = [
     "P0_THRUST_STD",
-    "Q_THRUST",
     "Q_THRUST_BASE",
-    "THRUST_EPSILON",
-    "THRUST_RATE_MAX",
-    "THRUST_MEMORY_STEPS",
     "WINDOWS",
-    "SWEEPS",
     "ChaserStudy",
     "build_augmented_thrust",
     "chaser_study",
@@ -63,7 +56,6 @@ __all__ = [
     "plot_chaser",
     "plot_thrust_estimates",
     "run_passes",
-    "window_stats",
 ]
 
 #: Bound on the thrust's rate of change, N/s (documented prior; the truth's largest is 93 N/s).
@@ -84,7 +76,6 @@ WINDOWS = ((0.0, 500.0), (500.0, 1000.0))
 VARIANTS = ("plain", "st", "adaptive")
 
 
-@renamed_keywords(window="memory_steps")
 def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_std=P0_THRUST_STD, name=None, **options):
     """The thrust-augmented EKF of Sun 2011's chaser (see the module docstring).
 
@@ -98,8 +89,7 @@ def build_augmented_thrust(scenario, variant="plain", *, Q_input=None, P0_input_
     P0_input_std : float
         Initial σ of the thrust estimate, N.
     **options
-        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``memory_steps``, ``floor`` (adaptive; ``memory_steps`` was
-        ``window`` before issue 23, still accepted until hinfnav 0.3 with a DeprecationWarning).
+        ``rho``, ``beta``, ``a`` (st); ``epsilon``, ``memory_steps``, ``floor`` (adaptive).
 
     Returns
     -------
@@ -177,7 +167,6 @@ def _stats(res):
     return {f"{int(w[0])}-{int(w[1])}": window_stats(res.error, res.t, res.state, w) for w in WINDOWS}
 
 
-@scenario_moved("builder", "passes", "scenario", was=callable)
 def run_passes(scenario, builder, passes, *, diagnostics=()):
     """Several passes of one filter, each ``(truth, params)``, as one batch over all their runs.
 
@@ -291,14 +280,12 @@ _STYLE = {
 }
 
 
-@renamed_keywords(window_s="moving_rms_s")
 def plot_chaser(study, *, axes=None, moving_rms_s=10.0):
     """Fig 4 with the ideas added: per-axis position and velocity errors of run 0, every filter.
 
     Each curve is the moving RMS of the error over the last ``moving_rms_s`` seconds (log scale),
     so that the unaware EKF's metres and the others' centimetres show
-    together and the noisy curves do not hide each other. ``moving_rms_s`` was ``window_s`` before
-    issue 23 (still accepted until hinfnav 0.3, with a DeprecationWarning).
+    together and the noisy curves do not hide each other.
 
     Returns
     -------

@@ -11,14 +11,9 @@ from .constants import PAPER_Q_ASTEKF, PAPER_Q_BEST_AEKF
 
 __all__ = [
     "CLAIMS",
-    "COMPARABLE_FACTOR",
-    "CORRELATION_THRESHOLD",
     "QUOTES",
-    "INSENSITIVE_FACTOR",
-    "PLATEAU_ELASTICITY",
     "format_claims",
     "measure_claims",
-    "q_index",
 ]
 
 CLAIMS = {

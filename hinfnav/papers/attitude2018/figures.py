@@ -8,14 +8,11 @@ ensemble mean over runs, the oscillating error of :mod:`.studies`).
 
 import numpy as np
 
-from ...core.deprecation import renamed_keywords
 from ...plotting.errors import new_figure
 from .constants import PAPER_Q_ASTEKF, PAPER_Q_BEST_AEKF
 from .studies import EPSILON_FACTORS
 
 __all__ = [
-    "AXES",
-    "FIG_Q",
     "fig1",
     "fig2",
     "fig3",
@@ -27,10 +24,8 @@ __all__ = [
     "fig9",
     "fig_error_vs_rate",
     "fig_fading",
-    "fig_filter",
     "fig_q_sweep",
     "fig_tuning",
-    "plot_error_axes",
     "plot_torque",
 ]
 
@@ -244,11 +239,8 @@ def fig_error_vs_rate(study, Q=PAPER_Q_BEST_AEKF, name="aekf"):
     return fig
 
 
-@renamed_keywords(window="mean_steps")
 def fig_fading(study, mean_steps=300):
     """The ASTEKF's fading factor λ (run 0; all λᵢ equal with aᵢ = 1) and its moving mean over ``mean_steps`` steps.
-
-    ``mean_steps`` was ``window`` before issue 23 (still accepted until hinfnav 0.3, with a DeprecationWarning).
     """
     st = study.main["astekf"]
     lam = st.diagnostics["fading"][:, 0]

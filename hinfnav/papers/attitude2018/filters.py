@@ -20,9 +20,7 @@ three Sun 2011's scenario only.
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
-from ...core.deprecation import renamed_keywords
 from ...estimators.attitude import AttitudeAAEKF, AttitudeAEKF, AttitudeASTEKF
 from ...estimators.registry import Requires, register_estimator
 from ..sun2011.scenario import Scenario as ChaserScenario
@@ -74,11 +72,9 @@ def build_astekf(scenario, Q=PAPER_Q_ASTEKF, *, rho=DEFAULT_ST["rho"], beta=DEFA
                           beta=beta, a=a, name=name, **options)
 
 
-@renamed_keywords(window="memory_steps")
 def build_aaekf(scenario, Q0=DEFAULT_AA["Q0"], *, epsilon=None, memory_steps=DEFAULT_AA["memory_steps"],
                 floor=DEFAULT_AA["floor"], name="aaekf", **options):
-    """The AAEKF on ``scenario``: Q(t₀) = Q0 I₃, ε (default :func:`default_epsilon`; may be one per run), m = memory_steps
-    (``window`` before issue 23: still accepted until hinfnav 0.3, with a DeprecationWarning)."""
+    """The AAEKF on ``scenario``: Q(t₀) = Q0 I₃, ε (default :func:`default_epsilon`; may be one per run), m = memory_steps."""
     _check(scenario)
     epsilon = default_epsilon(Q0=float(np.max(Q0)), omega_e=scenario.omega_e) if epsilon is None else epsilon
     return AttitudeAAEKF(scenario.system(), scenario.measurement, P0=scenario.P0, Q=torque_density(Q0),
@@ -88,7 +84,6 @@ def build_aaekf(scenario, Q0=DEFAULT_AA["Q0"], *, epsilon=None, memory_steps=DEF
 _BUILDERS = {"aekf": build_aekf, "astekf": build_astekf, "aaekf": build_aaekf}
 
 
-@scenario_moved("name", "scenario", was=str)
 def build_attitude_filter(scenario, name, **options):
     """One of :data:`ATTITUDE_FILTERS` by name."""
     if name not in _BUILDERS:

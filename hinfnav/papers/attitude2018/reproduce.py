@@ -26,7 +26,7 @@ from .figures import (
 from .scenario import Scenario
 from .studies import attitude_study
 
-__all__ = ["NOTEBOOKS", "reproduce", "stats_entry", "summarize"]
+__all__ = ["NOTEBOOKS", "reproduce", "summarize"]
 
 #: This paper's chapter of the workbook (``reproduce(notebooks=True)``).
 NOTEBOOKS = (

@@ -216,7 +216,7 @@ class Scenario(BaseScenario):
         return np.diag(self.P0_std**2)
 
     def truth_model(self, hold=True):
-        """What the simulation layer needs (run with :func:`hinfnav.sim.nonlinear.simulate_nonlinear_truth`).
+        """What the simulation layer needs (run with :func:`hinfnav.sim.simulate_truth`).
 
         Parameters
         ----------

@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from ...core.deprecation import scenario_moved
 from ...core.validation import as_int_at_least
 from ...metrics.errors import window_mask
 from ...metrics.intervals import mean_interval
@@ -38,14 +37,10 @@ from .scenario import Scenario, default_epsilon
 
 __all__ = [
     "EPSILON_FACTORS",
-    "ST_GRID",
-    "WINDOW_VALUES",
     "AttitudeStudy",
     "FilterStats",
     "attitude_study",
-    "dominant_period",
     "filter_stats",
-    "first_runs",
     "run_batched",
     "run_filter",
     "sweep_study",
@@ -161,7 +156,6 @@ def _elasticity(b, rate, low=0.5):
     return out
 
 
-@scenario_moved("label", "error", "t", "scenario", was=str)
 def filter_stats(scenario, label, error, t, *, params=None, keep=False, diagnostics=None):
     """Reduce an error history (runs, n_samples, 9) to :class:`FilterStats` over the scenario's window."""
     mask = window_mask(t, scenario.rms_window_s)
@@ -217,7 +211,6 @@ def first_runs(truth, k):
                  state=truth.state, measurement=truth.measurement)
 
 
-@scenario_moved("label", "estimator", "truth", "scenario", was=str)
 def run_filter(scenario, label, estimator, truth, *, params=None, keep=False, diagnostics=()):
     """One pass of an estimator over every run of ``truth``, reduced to :class:`FilterStats`."""
     hist = estimator.estimate(truth.y, truth.u, scenario.xhat0, keep_covariance=False,
@@ -226,7 +219,6 @@ def run_filter(scenario, label, estimator, truth, *, params=None, keep=False, di
     return filter_stats(scenario, label, err, truth.t, params=params, keep=keep, diagnostics=hist.diagnostics)
 
 
-@scenario_moved("builder", "key", "values", "truth", "scenario", was=callable)
 def run_batched(scenario, builder, key, values, truth, *, labels=None, keep=False, extra=None, **fixed):
     """A parameter sweep as one pass: ``builder(scenario, **{key: per-run values}, **fixed)`` over the repeated truth.
 

@@ -13,7 +13,6 @@ writes both as Markdown; :func:`plot_scenario_heatmap` draws one scenario's rati
 import numpy as np
 import pandas as pd
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure
 
@@ -103,7 +102,6 @@ def winners(table):
     return out
 
 
-@scenario_moved("table", "scenario", was=pd.DataFrame)
 def plot_scenario_heatmap(scenario, table, *, axes=None):
     """Heat map of log₁₀(RMS/bound) of one scenario: estimators × conditions, one panel per quantity.
 

@@ -32,7 +32,6 @@ sigma-point and a Huber filter beside its AEKF, ASTEKF and AAEKF.
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...estimators.attitude import AttitudeHuberEKF
 from ...estimators.augmented import AugmentedInputAdaptiveKF
@@ -49,7 +48,7 @@ from ..attitude2018.scenario import Scenario as AttitudeScenario
 from ..shi2018.campaign import kalman_model as shi_kalman_model
 from ..shi2018.scenario import Scenario as ShiScenario
 
-__all__ = ["GENERIC", "build_generic", "build_attitude_hbf", "build_attitude_ukf"]
+__all__ = ["build_generic", "build_attitude_hbf", "build_attitude_ukf"]
 
 #: Name → (kind, description).
 GENERIC = {
@@ -79,7 +78,6 @@ def _model(scenario):
     raise InputError(f"scenario {type(scenario).__name__} offers no kalman_model()")
 
 
-@scenario_moved("kind", "scenario", was=str)
 def build_generic(scenario, kind, **options):
     """One of the eight filters of the module table on ``scenario``'s Kalman model (``options`` to its class)."""
     m = _model(scenario)

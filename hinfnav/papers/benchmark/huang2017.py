@@ -51,7 +51,7 @@ from ...systems.linear import LinearSystem
 from ...systems.measurements import LinearMeasurement
 from ...systems.state import StateSpec
 
-__all__ = ["SETUP", "FILTERS", "huang_system", "huang_truth", "huang_filters", "huang_comparison", "paired_difference",
+__all__ = ["SETUP", "huang_system", "huang_truth", "huang_comparison",
            "plot_huang_comparison"]
 
 #: The paper's set-up (see the module docstring).

@@ -59,8 +59,8 @@ from ...estimators.registry import Requires, register_estimator
 from ...systems.uncertain import UncertainSystem
 from .estimators import _has_model, _model
 
-__all__ = ["SOLVER", "LinearDesign", "build_model_hinf", "build_model_lmi", "kalman_weights", "model_lmi_design",
-           "model_theta_max"]
+__all__ = ["LinearDesign", "build_model_hinf", "build_model_lmi", "model_lmi_design",
+           ]
 
 #: The LMI solver of ``model_lmi`` (interior point; the designs take about 0.1 s on the benchmark's models).
 SOLVER = "CLARABEL"

@@ -16,7 +16,7 @@ from .cross import WINDOW, cross_table, format_cross_markdown, plot_scenario_hea
 from .grid import SCENARIOS, load_papers, non_fitting, scenario_campaign
 from .limits import cell_bound
 
-__all__ = ["NOTEBOOKS", "reproduce", "BENCHMARK_RUNS", "BOUND_RUNS"]
+__all__ = ["NOTEBOOKS", "reproduce"]
 
 #: The comparison chapter of the workbook (``reproduce(notebooks=True)``).
 NOTEBOOKS = ("90_cross_paper_benchmark.ipynb",)

@@ -10,7 +10,6 @@ draws the ratios as a heat map.
 import numpy as np
 import pandas as pd
 
-from ...core.deprecation import scenario_keyword
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure
 from ..sun2011.scenario import Scenario
@@ -24,7 +23,6 @@ QUANTITIES = {"pos": ("position", "pos_m", "m"), "vel": ("velocity", "vel_mps", 
 _KEYS = ["estimator", "maneuver", "delta", "noise"]
 
 
-@scenario_keyword("results", "scenario")
 def benchmark_table(results, *, scenario=None):
     """One row per cell with the RMS per window, its 95 % interval, the cell's Kalman limit and the ratios.
 

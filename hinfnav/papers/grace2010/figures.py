@@ -3,11 +3,10 @@
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from ...core.deprecation import renamed_keywords
 from ...plotting.errors import new_figure
 from .constants import TRUTH_SIGMA_M
 
-__all__ = ["truth_figure", "mismatch_figure", "errors_figure", "RELATIVE_TRUTH_SIGMA_M"]
+__all__ = ["truth_figure", "mismatch_figure", "errors_figure"]
 
 #: 1σ of the truth's relative position per axis, m: two independent ≈ 2 cm orbits, √2 × 2 cm.
 RELATIVE_TRUTH_SIGMA_M = float(np.sqrt(2.0) * TRUTH_SIGMA_M)
@@ -56,12 +55,9 @@ def mismatch_figure(prop):
     return fig
 
 
-@renamed_keywords(window="rms_epochs")
 def errors_figure(t, errors, variant, names=None, rms_epochs=60):
     """RMS position error per Hill axis, a moving RMS over ``rms_epochs`` epochs (10 min), log scale, against
     time, with the truth's own ≈ 2.8 cm (1σ, relative) marked. ``errors``: filter name → (n, 6) error (m, m/s).
-
-    ``rms_epochs`` was ``window`` before issue 23 (still accepted until hinfnav 0.3, with a DeprecationWarning).
     """
     names = list(errors) if names is None else names
     fig, ax = new_figure(3, 1, figsize=(10, 8), sharex=True)

@@ -31,7 +31,6 @@ import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from ...core.exceptions import InputError
-from ...core.deprecation import renamed_keywords
 from ...core.validation import as_choice, as_seed
 from ...systems.hill import position_measurement
 from ...systems.measurements import (
@@ -49,7 +48,7 @@ from .constants import (
     OUTLIER_SCALE,
 )
 
-__all__ = ["VARIANTS", "DROPOUT_BLOCK", "MeasurementSet", "kband_noise", "make_measurements", "linear_form",
+__all__ = ["VARIANTS", "MeasurementSet", "kband_noise", "make_measurements", "linear_form",
            "shared_model_groups"]
 
 VARIANTS = ("kband_angles", "gnss", "gnss_outliers", "gnss_dropouts")
@@ -80,7 +79,6 @@ class MeasurementSet:
     notes: str
 
 
-@renamed_keywords(window="savgol_length")
 def kband_noise(data, savgol_length=11, order=3):
     """The K-band range's noise from the data (two independent estimates).
 
@@ -88,8 +86,6 @@ def kband_noise(data, savgol_length=11, order=3):
        the K-band series; the RMS residual, scaled by √(1/(1 − h₀)) for the fit's own leverage
        h₀ (the centre weight of the filter), is the white-noise σ at 10 s.
     2. Against the POD baseline: mean (a bias), standard deviation and max of ``K-band − |r_A − r_B|``.
-
-    ``savgol_length`` was ``window`` before issue 23 (still accepted until hinfnav 0.3, with a DeprecationWarning).
 
     Returns
     -------

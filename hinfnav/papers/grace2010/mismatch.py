@@ -31,7 +31,7 @@ from .dataset import hill_basis, inertial_to_hill
 from .dynamics import MODELS, pair, rk4
 
 __all__ = ["hill_transition", "propagation_errors", "one_step_mismatch", "delta_minima", "SUBSTEPS", "DELTA_SPAN",
-           "DELTA_GRID_STEP"]
+           ]
 
 #: The per-step δ search covers |δ| ≤ this (Φ is periodic in ω dt: far beyond, aliases of the same minima recur).
 DELTA_SPAN = 4.0

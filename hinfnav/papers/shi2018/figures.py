@@ -10,14 +10,11 @@ function takes ``ax=``/``axes=`` or returns a figure from
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...plotting.errors import new_figure, plot_error_axis
 from .constants import MANEUVER_TIME_S, PAPER_RESULTS
-from .studies import CaseResult
 
 __all__ = [
-    "FILTER_STYLE",
     "plot_case_errors",
     "errors_figure",
     "fig3",
@@ -27,7 +24,6 @@ __all__ = [
     "mixture_figures",
     "plot_maneuver_bias",
     "maneuver_figure",
-    "plot_ratio_sweep",
     "sweeps_figure",
 ]
 
@@ -158,7 +154,6 @@ def mixture_figures(mixture, summary=None):
                           f"{_numbers(summary, 'mixture', 'velocity')}"))
 
 
-@scenario_moved("result", "scenario", was=CaseResult)
 def plot_maneuver_bias(scenario, result, *, axes, filters=("ekf", "hbf"), span_s=300.0):
     """Mean error over the runs (the bias) of x and vx around the maneuver: how fast each filter follows it.
 
@@ -193,7 +188,6 @@ def plot_maneuver_bias(scenario, result, *, axes, filters=("ekf", "hbf"), span_s
     return artists
 
 
-@scenario_moved("result", "scenario", was=CaseResult)
 def maneuver_figure(scenario, result):
     """The reaction to the maneuver, mean over the Monte Carlo runs."""
     fig, axes = new_figure(1, 2, figsize=(10, 3.4))

@@ -36,7 +36,7 @@ from ...estimators.sigma_point import SigmaPointFilter
 from .constants import GAMMA
 from .scenario import Scenario
 
-__all__ = ["MEASUREMENTS", "EKF", "HBF", "build_hbf", "build_ukf", "build_stekf", "build_huber_stekf", "HBF_BASES"]
+__all__ = ["EKF", "HBF", "build_hbf", "build_ukf", "build_stekf", "build_huber_stekf"]
 
 #: How the filters use the readings: converted to position (the paper's indirect measurement) or directly.
 MEASUREMENTS = ("converted", "direct")

@@ -30,7 +30,7 @@ from ..grace2010.dynamics import pair, rk4, two_body_j2
 from .constants import MU_EARTH
 from .scenario import Scenario
 
-__all__ = ["HighFidelityScenario", "INCLINATION_DEG", "SUBSTEPS", "high_fidelity", "relative_trajectory"]
+__all__ = ["HighFidelityScenario", "SUBSTEPS", "high_fidelity", "relative_trajectory"]
 
 #: Inclination of the chaser's orbit, degrees (a choice: J2's differential effect depends on it).
 INCLINATION_DEG = 45.0

@@ -7,7 +7,7 @@ The paper's (6)–(15) are lost; they are rebuilt from Karlgaard & Schaub
 ``ρ(ζ) = ζ²/2`` for ``|ζ| ≤ γ``, ``γ|ζ| − γ²/2`` otherwise; the iterative
 (IRLS) solution (12)–(13) with weights ``ψ(ζ) = min(1, γ/|ζ|)``; the
 covariance (15) ``(MᵀΨM)⁻¹``. The filter itself uses
-:func:`hinfnav.huber_update` (IRLS with exact Newton steps); these helpers
+:func:`hinfnav.estimators.huber_update` (IRLS with exact Newton steps); these helpers
 show the plain IRLS iteration on one update.
 """
 

@@ -31,7 +31,6 @@ from ...core.linalg import discretize
 from ...core.validation import as_int_at_least, as_positive, as_real, as_vector
 from ...noise import MixtureNoise
 from ...sim.scenario import Scenario as BaseScenario
-from ...sim.scenario import renamed_fields
 from ...sim.truth import Truth, TruthModel, child_rngs, draw_noise, noise_models, simulate_truth
 from ...systems.hill import hill_matrices
 from ...systems.linear import LinearSystem
@@ -90,7 +89,6 @@ def _readonly_vector(name, value, n=6):
     return v
 
 
-@renamed_fields(window_s="rms_window_s")
 @dataclass(frozen=True, eq=False)
 class Scenario(BaseScenario):
     """Settings of Shi & Wang (2018)'s scenario as rebuilt here; defaults are the documented choices.
@@ -120,8 +118,7 @@ class Scenario(BaseScenario):
         The target's maneuver: at this time its relative velocity changes by
         this much along x, away from the chaser.
     rms_window_s : (float, float)
-        Window (start, end) of the accuracy statistic (the RMS error), s. Called
-        ``window_s`` before issue 23 (still accepted, with a DeprecationWarning).
+        Window (start, end) of the accuracy statistic (the RMS error), s.
     """
 
     n: float = ORBITAL_RATE

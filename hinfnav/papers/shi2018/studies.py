@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_int_at_least
 from ...metrics.errors import window_mask
@@ -37,22 +36,16 @@ __all__ = [
     "FilterStats",
     "CaseResult",
     "case_conditions",
-    "default_filters",
     "run_case",
     "accuracy",
-    "mc_interval",
     "filter_summary",
     "paired_gap",
     "maneuver_reaction",
-    "MANEUVER_WINDOWS",
     "maneuver_windows",
 ]
 
 #: The paper's cases (§3.1–3.3).
 CASES = ("gaussian", "mixture", "maneuver")
-
-#: Extra windows of the maneuver case: before it (from the window's start), the 200 s after it, the last 200 s.
-MANEUVER_WINDOWS = ("before", "reaction", "final")
 
 
 def maneuver_windows(scenario):
@@ -282,6 +275,7 @@ def paired_gap(a, b, values="per_run"):
     a, b : FilterStats
     values : {"per_run", "jitter"} or a window label
     """
+
     def pick(s):
         return getattr(s, values) if values in ("per_run", "jitter", "max_abs") else s.windows[values]
 
@@ -293,7 +287,6 @@ def paired_gap(a, b, values="per_run"):
             "pos_ratio": float(pa.mean() / pb.mean()), "vel_ratio": float(va.mean() / vb.mean())}
 
 
-@scenario_moved("result", "scenario", "dv", was=CaseResult)
 def maneuver_reaction(scenario, result, dv=None):
     """How each filter follows the unmodelled maneuver, from its bias (mean error over runs).
 

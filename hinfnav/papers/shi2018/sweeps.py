@@ -14,8 +14,6 @@
   undo part of the mistuning.
 """
 
-import numpy as np
-
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least, as_positive
 from .calibration import riccati_accuracy
@@ -24,7 +22,7 @@ from .scenario import Scenario
 from .studies import filter_summary, paired_gap, run_case
 
 __all__ = ["SENSOR_VARIANTS", "MISTUNING_FACTORS", "sensitivity_point", "mistuning_point", "sensitivity_sweep",
-           "mistuning_sweep", "ratio_table"]
+           "mistuning_sweep"]
 
 #: Variants of the true sensor errors: label → multipliers of (σ_ρ, σ_α, σ_a).
 SENSOR_VARIANTS = {
@@ -123,12 +121,3 @@ def mistuning_point(scenario, c, *, runs=40, seed=0, progress=False):
     res = run_case(scenario, "gaussian", {"hbf": HBF(scenario, **told), "ekf": EKF(scenario, **told)}, runs=runs,
                    seed=seed, progress=progress)
     return {"c": c, **_row(res)}
-
-
-def ratio_table(rows, key):
-    """``(labels, pos ratios, vel ratios)`` HBF/EKF of sweep rows (``key``: "variant" or "c")."""
-    labels = [r[key] for r in rows]
-    pos = np.array([r["hbf_minus_ekf"]["pos_ratio"] for r in rows])
-    vel = np.array([r["hbf_minus_ekf"]["vel_ratio"] for r in rows])
-    return labels, pos, vel
-

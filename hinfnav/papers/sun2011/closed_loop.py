@@ -27,7 +27,7 @@ from .designs import design_for_scenario
 from .filters import lti_from_matrices, make_estimator
 from .scenario import Scenario
 
-__all__ = ["CLOSED_LOOP_FILTERS", "ClosedLoopStudy", "closed_loop_study", "format_closed_loop", "plot_closed_loop"]
+__all__ = ["ClosedLoopStudy", "closed_loop_study", "format_closed_loop", "plot_closed_loop"]
 
 #: Filters closing the loop: key -> label.
 CLOSED_LOOP_FILTERS = {

@@ -37,7 +37,6 @@ from ...design.samples import SampleSet
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
 from ...systems.hill import uncertainty_F
-from .arguments import scenario_first, scenario_keyword
 from .constants import DEFAULT_DELTA_BARS, published_filter
 from .scenario import Scenario
 
@@ -212,7 +211,6 @@ class GammaSweep:
         ]
 
 
-@scenario_first("delta_bars", "scenario", "progress")
 def gamma_sweep(scenario: Scenario | None = None, delta_bars: Sequence[float] = DEFAULT_DELTA_BARS,
                 progress: bool = False, **options: Any) -> GammaSweep:
     """Certified designs for several δ̄ (Corollary 1 at each).
@@ -244,7 +242,6 @@ def gamma_sweep(scenario: Scenario | None = None, delta_bars: Sequence[float] = 
     return GammaSweep(dbs, tuple(results))
 
 
-@scenario_first("delta_bar", "solver", "scenario", "form")
 def design_report(scenario: Scenario | None = None, delta_bar: float | None = None, solver: str | None = None,
                   form: str = "general") -> dict[str, Any]:
     """JSON-ready summary of one certified design (for ``python -m hinfnav design``).
@@ -450,7 +447,6 @@ def _is_scenario_design(result):
     return own.A.shape == ref.A.shape and np.allclose(own.A, ref.A) and np.allclose(own.B, ref.B)
 
 
-@scenario_keyword("result", "path", "scenario")
 def save_design(result: DesignResult, path: str | os.PathLike[str], *,
                 scenario: Scenario | None = None) -> Path:
     """Save a design made for ``scenario`` (default the paper's) as a JSON design file.
@@ -474,7 +470,6 @@ def save_design(result: DesignResult, path: str | os.PathLike[str], *,
     return design_io.save_design(result, system, path, options=options, extra=extra)
 
 
-@scenario_keyword("path", "scenario")
 def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = None) -> DesignResult:
     """Load a design file and check it was made for ``scenario`` (default the paper's).
 
@@ -497,7 +492,6 @@ def load_design(path: str | os.PathLike[str], *, scenario: Scenario | None = Non
     return result
 
 
-@scenario_first("delta_bars", "scenario", scenario=None)
 def small_gain_bounds(scenario, delta_bars):
     """The small-gain number ``‖E(zI − A)⁻¹H‖∞`` of the design model across δ̄.
 
@@ -541,7 +535,7 @@ def small_gain_bounds(scenario, delta_bars):
 def small_gain_crossing(scenario=None, bracket=(0.5, 5.0)):
     """The δ̄ at which the printed factors' small-gain number reaches 1 (LMI (20) with them turns infeasible).
 
-    Root of ``small_gain_bounds([δ̄])["printed"] − 1`` by Brent's method in
+    Root of ``small_gain_bounds(None, [δ̄])["printed"] − 1`` by Brent's method in
     ``bracket`` (to 1e-6 in δ̄).
     """
     f = lambda d: small_gain_bounds(scenario, [d])["printed"][0] - 1.0

@@ -62,8 +62,6 @@ from .constants import DEFAULT_P0_STD, DEFAULT_SIGMA_ANGLE, DEFAULT_SIGMA_RANGE
 from .scenario import Scenario
 
 __all__ = [
-    "MEASUREMENT_MODELS",
-    "DYNAMICS_MODELS",
     "EKF",
     "build_ekf",
     "range_angle_measurements",

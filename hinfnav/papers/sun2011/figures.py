@@ -11,7 +11,7 @@ from ...sim.truth import simulate_truth
 from .filters import make_estimator
 from .scenario import Scenario
 
-__all__ = ["FIGURE_SIZES", "figure_errors", "paper_runs", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig7_result", "plot_thrust"]
+__all__ = ["figure_errors", "paper_runs", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig7_result", "plot_thrust"]
 
 
 def plot_thrust(result, *, ax, run=0):

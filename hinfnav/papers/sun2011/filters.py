@@ -30,7 +30,6 @@ import numpy as np
 from ...core.exceptions import InputError
 from ...core.validation import as_choice
 from ...estimators.registry import Requires, register_estimator
-from .arguments import scenario_first
 from .constants import published_filter
 from .designs import design_for_scenario
 from .ekf import build_ekf
@@ -39,17 +38,13 @@ from .scenario import Scenario
 if TYPE_CHECKING:
     from ...estimators.base import Estimator
 
-__all__ = ["FILTER_NAMES", "VERBATIM", "BUILDERS", "make_estimator", "build_published", "build_designed",
+__all__ = ["FILTER_NAMES", "BUILDERS", "make_estimator", "build_published", "build_designed",
            "lti_from_matrices"]
 
 FILTER_NAMES = ("published", "published_closed_loop", "designed", "designed_closed_loop", "designed_observer",
                 "designed_observer_closed_loop", "ekf", "ekf_known_input")
 
-#: Filters run exactly as (12), assuming u = K x (the others are told the applied thrust).
-VERBATIM = ("published_closed_loop", "designed_closed_loop", "designed_observer_closed_loop")
 
-
-@scenario_first("A_F", "B_F", "C_F", "scenario")
 def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_dt=None):
     """Wrap filter matrices designed on ``scenario``'s closed loop as an estimator.
 
@@ -82,7 +77,6 @@ def lti_from_matrices(scenario, A_F, B_F, C_F, *, name, uses_input=True, design_
     return scenario.lti_filter(A_F, B_F, C_F, name=name, uses_input=uses_input, design_dt=design_dt)
 
 
-@scenario_first("name", "scenario")
 def make_estimator(scenario: Scenario, name: str, **options: Any) -> Estimator:
     """Build an estimator by name (see the module table).
 

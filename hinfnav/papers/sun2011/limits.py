@@ -43,7 +43,6 @@ from ...analysis.riccati import stationary_lti_error_covariance, steady_state_ka
 from ...core.exceptions import InputError
 from ...core.validation import as_choice, as_matrix, as_real
 from ...systems.hill import measurement_matrix
-from .arguments import scenario_first
 from .scenario import Scenario
 
 __all__ = ["KalmanLimit", "kalman_limit", "lti_error_covariance"]
@@ -157,7 +156,6 @@ def kalman_limit(scenario: Scenario, maneuver: bool = True, discretization: str 
     )
 
 
-@scenario_first("A_F", "B_F", "C_F", "scenario")
 def lti_error_covariance(
     scenario: Scenario, A_F: ArrayLike, B_F: ArrayLike, C_F: ArrayLike, *, maneuver: bool = True,
     input_matrix: ArrayLike | None = None, K: ArrayLike | None = None, delta: float = 0.0, discretization: str = "exact"

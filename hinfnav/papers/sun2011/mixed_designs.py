@@ -35,7 +35,6 @@ from ...core.validation import as_int_at_least, as_positive
 from ...design.mixed import front_gammas, knee_index, mixed_front, synthesize_mixed
 from ...lmi.conditioning import prepare_uncertainty
 from ...lmi.robust_brl import robust_bounded_real_lmi
-from .arguments import scenario_first
 from .designs import delta_grid, delta_samples, design_for_scenario, design_report_from, with_grid
 from .scenario import Scenario
 
@@ -43,7 +42,7 @@ if TYPE_CHECKING:
     from ...design.mixed import DesignResult
 
 __all__ = ["mixed_design_for_scenario", "mixed_front_for_scenario", "mixed_design_report",
-           "format_mixed_design_report", "analysis_gamma", "certify_front", "certified_knee"]
+           "format_mixed_design_report", "certified_knee"]
 
 
 def _setup(scenario, delta_bar, delta_points, options):
@@ -219,7 +218,6 @@ def _h2_fields(res):
     }
 
 
-@scenario_first("delta_bar", "gamma", "solver", "scenario", "points")
 def mixed_design_report(scenario=None, delta_bar=None, gamma=None, solver=None, points=12):
     """JSON-ready summary of a mixed design, or of the front and its knee.
 

@@ -40,7 +40,7 @@ from .limits import kalman_limit, lti_error_covariance
 from .mixed_designs import certified_knee, mixed_front_for_scenario
 from .scenario import Scenario
 
-__all__ = ["ParetoStudy", "pareto_study", "worst_h2", "robustness_cost", "format_pareto_table", "plot_front",
+__all__ = ["ParetoStudy", "pareto_study", "robustness_cost", "format_pareto_table", "plot_front",
            "plot_front_accuracy"]
 
 

@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from ...systems.linear import LinearSystem
     from ...systems.measurements import LinearMeasurement
 
-__all__ = ["Scenario", "paper_scenario", "DISCRETIZATIONS"]
+__all__ = ["Scenario", "paper_scenario"]
 
 #: Truth discretizations: exact zero-order hold (default) or the paper's Euler (6).
 DISCRETIZATIONS = ("exact", "euler")

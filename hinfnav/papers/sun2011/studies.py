@@ -17,7 +17,6 @@ from ...metrics.errors import axes_rms, max_error, rms_error, rms_per_run
 from ...sim.montecarlo import run_estimator, simulate
 from ...sim.truth import simulate_truth
 from .constants import published_filter
-from .arguments import scenario_first
 from .designs import design_for_scenario
 from .filters import lti_from_matrices
 from .limits import lti_error_covariance
@@ -84,7 +83,6 @@ def sweep_result(sweep, delta_bar):
     return sweep.results[int(matches[0])]
 
 
-@scenario_first("A_F", "B_F", "C_F", "scenario")
 def stationary_std(scenario, A_F, B_F, C_F, *, maneuver=True, discretization="euler"):
     """Noise-only stationary per-axis standard deviations (position m, velocity m/s) of a filter.
 
@@ -145,7 +143,6 @@ def format_robustness_table(rows):
     return "\n".join(lines)
 
 
-@scenario_first("design", "scenario", "runs", "seed")
 def simulation_comparison(scenario=None, design=None, runs=20, seed=0, *, observer=None, starts=("paper", "rest"),
                           delta_bar=None):
     """Monte Carlo RMS errors of the published and the re-synthesized filters.

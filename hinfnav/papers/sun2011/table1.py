@@ -39,8 +39,8 @@ from .filters import lti_from_matrices, make_estimator
 from .limits import kalman_limit
 from .scenario import Scenario
 
-__all__ = ["TABLE_FILTERS", "filter_labels", "CASES", "ROW_FILTERS", "FOOTNOTES", "Table1", "table1", "table1_rows",
-           "format_table1", "write_table1", "case_cell", "cell_values", "cell_from_values", "row_command"]
+__all__ = ["TABLE_FILTERS", "filter_labels", "CASES", "Table1", "table1", "table1_rows",
+           "format_table1", "write_table1", "row_command"]
 
 #: Filters of the reproduced table: key -> (label, builder name)
 TABLE_FILTERS = {
@@ -130,12 +130,6 @@ def cell_from_values(pos_run, vel_run, pos_axes0, vel_axes0):
         out[f"mc_ci95_{key}"] = [low, high]
         out[f"mc_spread95_{key}"] = [float(v) for v in np.percentile(vals, [2.5, 97.5])]
     return out
-
-
-def case_cell(result, t, window):
-    """One Table 1 cell: single-run and Monte Carlo position and velocity RMS of a result."""
-    pos_run, vel_run, pos_axes, vel_axes = cell_values(result, t, window)
-    return cell_from_values(pos_run, vel_run, pos_axes[0], vel_axes[0])
 
 
 #: The ``simulate --filter`` name that reproduces each row, per case (maneuver: the H∞

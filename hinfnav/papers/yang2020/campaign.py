@@ -27,7 +27,7 @@ from ...noise import make_noise
 from .constants import P0_DIAGONAL
 from .scenario import LinearTruth, Scenario
 
-__all__ = ["CampaignScenario", "campaign_scenario", "OFFERS"]
+__all__ = ["CampaignScenario", "OFFERS"]
 
 #: Additive error, the saturated accelerometers of the drag-free axes, the applied force known, linear dynamics.
 OFFERS = Offers(error_form="additive", measurement="saturated_accelerometer", input=True, linear=True,

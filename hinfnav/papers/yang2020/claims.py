@@ -9,7 +9,7 @@ reading decides it. Each record quotes the paper (``quote``, Section 3 in the or
 ``quote_en``, an English rendering made for this workbook).
 """
 
-__all__ = ["CLAIM_IDS", "evaluate_claims", "format_claims", "QUOTES", "VERDICTS", "OVERSHOOT_LIMIT", "SETTLING_LIMIT_S"]
+__all__ = ["evaluate_claims", "format_claims", "QUOTES", "VERDICTS", "OVERSHOOT_LIMIT"]
 
 VERDICTS = ("holds", "does not hold", "holds in part", "holds under some readings")
 

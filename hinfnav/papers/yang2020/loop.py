@@ -51,7 +51,7 @@ from .filters import build_alg1, build_alg2, build_fused
 from .model import MEASURED_INDICES, disturbance
 from .scenario import CONTROLLERS, check_scenario
 
-__all__ = ["LoopResult", "run_closed_loop", "run_closed_loops", "CONTROLLER_FIELDS", "residual_acceleration", "Alg2Bank", "BLOCK", "PASSIVE"]
+__all__ = ["LoopResult", "run_closed_loop", "run_closed_loops", "residual_acceleration", "Alg2Bank", "BLOCK", "PASSIVE"]
 
 #: Steps per block of noise drawn at once.
 BLOCK = 10_000

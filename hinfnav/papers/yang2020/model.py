@@ -48,7 +48,6 @@ __all__ = [
     "plant_state_spec",
     "extended_state_spec",
     "dragfree_state_spec",
-    "EXTENDED_FROM_AUGMENTED",
     "DRAGFREE_INDICES",
     "MEASURED_INDICES",
 ]

@@ -39,7 +39,7 @@ from .studies import (
     truncated,
 )
 
-__all__ = ["NOTEBOOKS", "reproduce", "READING_RUNS", "reading_study", "reading_studies", "integral_study",
+__all__ = ["NOTEBOOKS", "reproduce", "READING_RUNS", "reading_study", "integral_study",
            "algorithm_windows"]
 
 #: This paper's chapter of the workbook (``reproduce(notebooks=True)``).

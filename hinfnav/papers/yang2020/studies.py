@@ -11,12 +11,11 @@ import dataclasses
 import numpy as np
 from scipy.signal import welch
 
-from ...core.deprecation import scenario_moved
 from ...core.exceptions import InputError
 from ...core.validation import as_int_at_least
 from .constants import ACTUATOR_BOUND, REQUIREMENT_ASD, REQUIREMENT_BAND_HZ, STEP_COMMAND
 from .filters import build_alg1, build_alg2
-from .loop import Alg2Bank, LoopResult, residual_acceleration
+from .loop import Alg2Bank, residual_acceleration
 
 __all__ = [
     "NPERSEG",
@@ -29,11 +28,9 @@ __all__ = [
     "step_response",
     "saturation_summary",
     "linear_loop_radius",
-    "replay_alg2",
     "truncated",
     "asd_sensitivity",
     "SENSITIVITY_NPERSEG",
-    "THETA_READINGS",
     "theta_readings_study",
 ]
 
@@ -371,7 +368,6 @@ def asd_sensitivity(result, reading="test_mass", *, settle_s=2000.0, lengths=Non
             "spread": float(values.max() / values.min() - 1.0)}
 
 
-@scenario_moved("result", "scenario", was=LoopResult)
 def theta_readings_study(scenario, result, *, axis=0, readings=None):
     """L1, L2, L3 on one loop's readings under several readings of θ, and what drives L1's bias.
 
