@@ -74,7 +74,8 @@ from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least, as_seed
 from ..lmi.blocks import gamma_index, lmi20_matrix
 from ..lmi.conditioning import lmi20_diagonal, normalize, prepare
-from ..lmi.solve import SolverOptions, lmi20_problem, solve_lmi
+from ..lmi.lmi20 import lmi20_problem, solve_lmi
+from ..lmi.solve import SolverOptions
 from ..systems.uncertain import UncertainSystem
 from .arguments import system_argument
 from .explain import infeasibility_hint

@@ -9,7 +9,8 @@ from .blocks import gamma_index, lmi20_matrix, observer_lmi_matrix
 from .conditioning import Prepared, pow2, prepare, prepare_uncertainty, state_scaling
 from .polytopic import extended_h2_matrices, extended_hinf_positive, solve_polytopic_hinf
 from .robust_brl import robust_bounded_real_lmi
-from .solve import INFEASIBLE, METHODS, SOLVERS, LMIProblem, Solution, SolverOptions, lmi20_problem, run_solver, solve_lmi
+from .lmi20 import lmi20_problem, solve_lmi
+from .solve import INFEASIBLE, METHODS, SOLVERS, LMIProblem, Solution, SolverOptions, run_solver
 
 __all__ = [
     "lmi20_matrix",

@@ -314,7 +314,7 @@ def normalize(P, threshold=NORMALIZE_THRESHOLD):
     the filter is the same (``A_F``, ``B_F`` unchanged, ``C_F = ν C'_F``).
     ρ and ν are powers of two, so the scaling is undone exactly in floating
     point (:meth:`Prepared.unnormalized`, and
-    :func:`hinfnav.lmi.solve.solve_lmi` returns its solutions in the
+    :func:`hinfnav.lmi.lmi20.solve_lmi` returns its solutions in the
     original units). Input scaling of w and v *separately* is not a
     congruence (it changes the H∞ problem), so it is not done.
 
