@@ -95,7 +95,7 @@ def test_callables_without_var_keyword_refuse_an_unknown_keyword_by_name():
         else:
             wrong.append(f"{modname}.{name}: accepted {BAD}=")
     assert wrong == []
-    assert len(unnamed) < 60, unnamed  # numba kernels, bare bases and exceptions only
+    assert len(unnamed) < 80, unnamed  # numba kernels (one per compiled model function), bare bases, exceptions
 
 
 # ---- callables with **kwargs: valid arguments plus the unknown keyword --------------------------------------
@@ -270,6 +270,8 @@ DATA_KEYWORDS = {
     "hinfnav.plotting.plot_sigma": "matplotlib line properties (matplotlib refuses an unknown one by name)",
     "hinfnav.plotting.plot_worst_case_over_delta": "matplotlib line properties (matplotlib refuses by name)",
     "hinfnav.papers.grace2010.NonlinearPredictionEKF": "the EKF's options (the EKF refuses an unknown one)",
+    "hinfnav.papers.grace2010.filters.CompiledNonlinearPredictionEKF": "the EKF's options (the EKF refuses one)",
+    "hinfnav.design.certify_loop.loop_outcome": "extra fields of the outcome dict, recorded as given (internal)",
 }
 
 CALLS = _calls()
