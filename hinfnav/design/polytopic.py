@@ -444,8 +444,8 @@ def observer_nominal(system, dt, solvers, t_start, state_scaling=None):
 def _in_unit_free_coordinates(system, **kw):
     """:func:`synthesize_polytopic` in the unit-free state coordinates, certified on the original data (internal).
 
-    With ``x = T x̃``, ``T = diag(σ)`` from :func:`~hinfnav.lmi.conditioning.unit_scaling` (on ``Σ|Aᵢ|``, the
-    columns of every ``Bᵢ`` and the rows of every ``Cᵢ``, ``Lᵢ``), each vertex is ``(T⁻¹AᵢT, T⁻¹Bᵢ, CᵢT, Dᵢ,
+    With ``x = T x̃``, ``T = diag(σ)`` from :func:`~hinfnav.lmi.conditioning.unit_scaling` (on ``Σ|Aᵢ|`` and
+    the row norms of the ``Bᵢ`` against the column norms of the ``[Cᵢ; Lᵢ]``), each vertex is ``(T⁻¹AᵢT, T⁻¹Bᵢ, CᵢT, Dᵢ,
     LᵢT)``, rounded to :data:`~hinfnav.lmi.conditioning.SOLVER_DATA_BITS` bits so that the same plant in other
     units gives the solver bitwise the same data. The error system's transfer function, hence γ, is unchanged:
 
@@ -468,8 +468,12 @@ def _in_unit_free_coordinates(system, **kw):
             "state_scaling='units' not applied: cells and the augmented observer are designed in the given state "
             "coordinates",))
     verts = system.vertices
-    sig = unit_scaling(sum(np.abs(v.A) for v in verts), np.hstack([v.B for v in verts]),
-                       np.vstack([np.vstack([v.C, v.L]) for v in verts]))
+    # the coupling K = Σ|Aᵢ| + u vᵀ (u_i: norm of row i of every Bᵢ, v_j: norm of column j of every [Cᵢ; Lᵢ]) moves
+    # with the units as A does (K_ij ∝ t_j / t_i) and closes the chains of a double integrator, which |A| alone
+    # leaves open (Osborne's iteration then cannot remove a position/velocity unit ratio)
+    u = np.linalg.norm(np.hstack([v.B for v in verts]), axis=1)
+    w = np.linalg.norm(np.vstack([np.vstack([v.C, v.L]) for v in verts]), axis=0)
+    sig = unit_scaling(sum(np.abs(v.A) for v in verts), u[:, None], w[None, :])
     if not (np.all(np.isfinite(sig)) and np.all(sig > 0)):
         sig = np.ones(verts[0].A.shape[0])
     scaled = PolytopicSystem(tuple(dataclasses.replace(
