@@ -40,7 +40,7 @@ from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
 from ..lmi.polytopic import extended_h2_matrices, extended_hinf_positive, hinf_gamma_index, polytopic_problem
-from ..lmi.conditioning import pow2, round_mantissa, unit_scaling
+from ..lmi.conditioning import noise_scale, pow2, round_mantissa, unit_scaling
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
@@ -209,7 +209,8 @@ def _check(system, form):
 
 def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-dependent", form: str = "general",
                          solver: str | None = None, grid_points: int | None = None, seed: int | np.random.Generator = 0,
-                         objective: str = "hinf", state_scaling: str | None = None) -> DesignResult:
+                         objective: str = "hinf", state_scaling: str | None = None,
+                         _steps: tuple = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)) -> DesignResult:
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters
@@ -293,8 +294,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
-    run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
-                            steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
+    run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0, steps=_steps)
     log, seconds = run.log, run.seconds
     statuses = [f"{slv} {st}" for slv, st in run.statuses]
     top = run.best()
@@ -471,7 +471,8 @@ def _in_unit_free_coordinates(system, **kw):
     # the coupling K = Σ|Aᵢ| + u vᵀ (u_i: norm of row i of every Bᵢ, v_j: norm of column j of every [Cᵢ; Lᵢ]) moves
     # with the units as A does (K_ij ∝ t_j / t_i) and closes the chains of a double integrator, which |A| alone
     # leaves open (Osborne's iteration then cannot remove a position/velocity unit ratio)
-    u = np.linalg.norm(np.hstack([v.B for v in verts]), axis=1)
+    # (u from B/ρ₀, ρ₀ = noise_scale: unit-free and ∝ the noise, so σ does not move with B, D × k either)
+    u = np.linalg.norm(np.hstack([v.B for v in verts]), axis=1) / max(noise_scale(v) for v in verts)
     w = np.linalg.norm(np.vstack([np.vstack([v.C, v.L]) for v in verts]), axis=0)
     sig = unit_scaling(sum(np.abs(v.A) for v in verts), u[:, None], w[None, :])
     if not (np.all(np.isfinite(sig)) and np.all(sig > 0)):
@@ -480,8 +481,8 @@ def _in_unit_free_coordinates(system, **kw):
         v, A=round_mantissa(v.A * sig[None, :] / sig[:, None]), B=round_mantissa(v.B / sig[:, None]),
         C=round_mantissa(v.C * sig[None, :]), L=round_mantissa(v.L * sig[None, :])) for v in verts),
         system.dt, system.labels, system.cells)
-    try:
-        res = synthesize_polytopic(scaled, **kw)
+    try:  # interior points from 1e-7 above the solver's level: the minimiser may sit on the LMI's boundary
+        res = synthesize_polytopic(scaled, **kw, _steps=(1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
     except (InfeasibleLMIError, CertificationError) as exc:
         res, why = None, f"{type(exc).__name__}: {exc}"
     if res is not None:
