@@ -70,7 +70,8 @@ def _vertex_norms(result, form):
     return max(norms)
 
 
-CASES = [("double_integrator", "observer", 4), ("two_mass_spring_30pct", "general", 4)]
+CASES = [("double_integrator", "observer", 4), ("double_integrator_position", "observer", 4),
+         ("two_mass_spring_30pct", "general", 4)]
 
 
 @pytest.fixture(scope="module")
@@ -78,9 +79,9 @@ def reference():
     return {(name, form): design_from_system_file(EXAMPLES / f"{name}.toml", form=form)[0] for name, form, _ in CASES}
 
 
-# the double integrator (~0.1 s a design) fast; the two-mass polytope (~1 s a design) fast at one factor, slow otherwise
+# the double integrators (~0.1 s a design) fast; the two-mass polytope (~1 s a design) fast at one factor, slow otherwise
 PARAMS = [pytest.param(name, form, n, which, factor,
-                       marks=() if name == "double_integrator" or (factor, which) == (1e-3, "positions")
+                       marks=() if name.startswith("double_integrator") or (factor, which) == (1e-3, "positions")
                        else pytest.mark.slow)
           for name, form, n in CASES for which in ("all", "positions") for factor in FACTORS]
 
