@@ -71,7 +71,7 @@ def _vertex_norms(result, form):
 
 
 CASES = [("double_integrator", "observer", 4), ("double_integrator_position", "observer", 4),
-         ("two_mass_spring_30pct", "general", 4)]
+         ("two_mass_spring_30pct", "general", 4), ("two_mass_spring_30pct", "observer", 4)]
 
 
 @pytest.fixture(scope="module")

@@ -44,7 +44,7 @@ from ..lmi.conditioning import noise_scale, pow2, round_mantissa, unit_scaling
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
-from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
+from .augmented import DOUBLING, augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
 from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
 from .certify_loop import Check, solve_and_certify
@@ -210,7 +210,7 @@ def _check(system, form):
 def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-dependent", form: str = "general",
                          solver: str | None = None, grid_points: int | None = None, seed: int | np.random.Generator = 0,
                          objective: str = "hinf", state_scaling: str | None = None,
-                         _steps: tuple = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)) -> DesignResult:
+                         _steps: tuple | None = None) -> DesignResult:
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters
@@ -272,7 +272,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         return _in_unit_free_coordinates(system, lyapunov=lyapunov, form=form, solver=solver, grid_points=grid_points,
                                          seed=seed, objective=objective)
     if form == "observer" and objective == "hinf" and needs_augmented(system):
-        return _augmented_result(system, lyapunov, solvers, alphas, t0)
+        return _augmented_result(system, lyapunov, solvers, alphas, t0, _steps)
     _check(system, form)
     if form == "general" and objective == "hinf" and system.cells:
         return _cells_result(system, lyapunov, solvers, t0)
@@ -294,7 +294,8 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
 
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
-    run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0, steps=_steps)
+    run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
+                            steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1) if _steps is None else _steps)
     log, seconds = run.log, run.seconds
     statuses = [f"{slv} {st}" for slv, st in run.statuses]
     top = run.best()
@@ -346,9 +347,10 @@ def _noise_normalisation(verts):
     return float(s)
 
 
-def _augmented_result(system, lyapunov, solvers, alphas, t0):
+def _augmented_result(system, lyapunov, solvers, alphas, t0, steps=None):
     """Observer form when A, C or L vary: the augmented error system [x_s; e] (:mod:`.augmented`; internal)."""
-    out = design_augmented_observer(system, lyapunov, solvers, alphas if not system.cells else None)
+    out = design_augmented_observer(system, lyapunov, solvers, alphas if not system.cells else None,
+                                    steps=steps + DOUBLING if steps is not None else DOUBLING)
     alphas = out["alphas"]
     if not out["ok"]:
         if all(any(s.endswith(st) for st in INFEASIBLE) for s in out["statuses"]):
@@ -462,10 +464,11 @@ def _in_unit_free_coordinates(system, **kw):
     """
     t0 = time.perf_counter()
     form, objective = kw["form"], kw["objective"]
-    if system.cells or (form == "observer" and objective == "hinf" and needs_augmented(system)):
+    augmented = form == "observer" and objective == "hinf" and needs_augmented(system)
+    if system.cells and form == "general" and objective == "hinf":
         res = synthesize_polytopic(system, **kw)
         return dataclasses.replace(res, attempts=res.attempts + (
-            "state_scaling='units' not applied: cells and the augmented observer are designed in the given state "
+            "state_scaling='units' not applied: the general form on cells is designed in the given state "
             "coordinates",))
     verts = system.vertices
     # the coupling K = Σ|Aᵢ| + u vᵀ (u_i: norm of row i of every Bᵢ, v_j: norm of column j of every [Cᵢ; Lᵢ]) moves
@@ -482,11 +485,20 @@ def _in_unit_free_coordinates(system, **kw):
         C=round_mantissa(v.C * sig[None, :]), L=round_mantissa(v.L * sig[None, :])) for v in verts),
         system.dt, system.labels, system.cells)
     try:  # interior points from 1e-7 above the solver's level: the minimiser may sit on the LMI's boundary
-        res = synthesize_polytopic(scaled, **kw, _steps=(1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
+        res = synthesize_polytopic(scaled, **kw, _steps=(1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+                                   if not augmented else (1e-7, 1e-6, 1e-5, 1e-4, 1e-3))
     except (InfeasibleLMIError, CertificationError) as exc:
         res, why = None, f"{type(exc).__name__}: {exc}"
     if res is not None:
-        if form == "observer":
+        if augmented:
+            # read part in the original coordinates: the row space of T̃ diag(σ)⁻¹, orthonormal rows (as read_part's)
+            c, Tt = system.center(), np.atleast_2d(np.asarray(res.witness["T"], dtype=float))
+            T = np.linalg.qr((Tt / sig[None, :]).T)[0].T
+            M = T @ (sig[:, None] * Tt.T)
+            B_F = sig[:, None] * res.B_F
+            A_F, C_F = c.A + B_F @ c.C, -c.L.copy()
+            S = None
+        elif form == "observer":
             v0 = verts[0]
             B_F = sig[:, None] * res.B_F
             A_F, C_F = v0.A + B_F @ v0.C, -v0.L.copy()
@@ -494,10 +506,17 @@ def _in_unit_free_coordinates(system, **kw):
         else:
             A_F, B_F, C_F = res.A_F, res.B_F, res.C_F
             S = np.concatenate([sig, np.ones(res.A_F.shape[0])])
-        cong = np.outer(1.0 / S, 1.0 / S)
-        witness = dict(res.witness, P=[cong * np.asarray(P) for P in res.witness["P"]], G=cong * res.witness["G"])
+        if S is None:
+            Si = np.linalg.inv(np.block([[M, np.zeros((M.shape[0], sig.size))],
+                                         [np.zeros((sig.size, M.shape[1])), np.diag(sig)]]))
+            witness = dict(res.witness, P=[Si.T @ np.asarray(P) @ Si for P in res.witness["P"]],
+                           G=np.einsum("ji,...jk,kl->...il", Si, np.asarray(res.witness["G"]), Si), T=T, C0=c.C.copy())
+        else:
+            cong = np.outer(1.0 / S, 1.0 / S)
+            witness = dict(res.witness, P=[cong * np.asarray(P) for P in res.witness["P"]], G=cong * res.witness["G"])
         gamma_c, _ = certify_polytopic(system, A_F, B_F, C_F, witness, form)
-        norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, res.alphas, objective)
+        norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, res.alphas, objective,
+                                        witness=witness if augmented else None)
         if np.isfinite(gamma_c) and np.all(radii < 1.0) and np.max(norms) <= gamma_c * (1 + 1e-9):
             k = int(np.argmax(norms))
             return dataclasses.replace(
