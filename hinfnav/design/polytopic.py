@@ -477,7 +477,8 @@ def _in_unit_free_coordinates(system, **kw):
     # (u from B/ρ₀, ρ₀ = noise_scale: unit-free and ∝ the noise, so σ does not move with B, D × k either)
     u = np.linalg.norm(np.hstack([v.B for v in verts]), axis=1) / max(noise_scale(v) for v in verts)
     w = np.linalg.norm(np.vstack([np.vstack([v.C, v.L]) for v in verts]), axis=0)
-    sig = unit_scaling(sum(np.abs(v.A) for v in verts), u[:, None], w[None, :])
+    # (2000 sweeps: the flexible attitude polytope needs ~1000 to converge to 1e-13; the iteration stops when converged)
+    sig = unit_scaling(sum(np.abs(v.A) for v in verts), u[:, None], w[None, :], sweeps=2000)
     if not (np.all(np.isfinite(sig)) and np.all(sig > 0)):
         sig = np.ones(verts[0].A.shape[0])
     scaled = PolytopicSystem(tuple(dataclasses.replace(
