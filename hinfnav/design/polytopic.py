@@ -275,7 +275,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         return _augmented_result(system, lyapunov, solvers, alphas, t0, _steps)
     _check(system, form)
     if form == "general" and objective == "hinf" and system.cells:
-        return _cells_result(system, lyapunov, solvers, t0)
+        return _cells_result(system, lyapunov, solvers, t0, _steps)
     verts = _vertex_tuples(system)
     rho = _noise_normalisation(verts) if objective == "hinf" else 1.0
     if rho != 1.0:  # (E1) with B̄/ρ at level γ²/ρ² is a congruence of (E1): same witness, γ × ρ (issue 36)
@@ -376,9 +376,10 @@ def _augmented_result(system, lyapunov, solvers, alphas, t0, steps=None):
         objective="hinf")
 
 
-def _cells_result(system, lyapunov, solvers, t0):
+def _cells_result(system, lyapunov, solvers, t0, steps=None):
     """General form on a polytope with cells: :mod:`.cells` (internal)."""
-    out = design_cells_general(system, lyapunov, solvers)
+    out = design_cells_general(system, lyapunov, solvers,
+                               *(() if steps is None else (steps + (0.2, 1.0),)))
     if not out["ok"]:
         raise CertificationError("no general-form solution of (E1) on the cells passed certification (solver status: "
                                  + "; ".join(out["statuses"]) + "): " + " | ".join(out["log"]))
@@ -459,17 +460,14 @@ def _in_unit_free_coordinates(system, **kw):
     (E1)/(E2) map by the congruence ``diag(S⁻ᵀ, S⁻ᵀ, I, I)``: ``P = S⁻ᵀ P̃ S⁻¹``, ``G = S⁻ᵀ G̃ S⁻¹``, ``W``
     unchanged. The mapped filter and witness are certified again by :func:`certify_polytopic` and the sampled
     norms on the ORIGINAL vertices; if that fails in float64 (conditioning), the design is redone as given and
-    the result's ``attempts`` say so. Cells and the augmented observer (their witnesses have another structure)
-    are designed as given, also said in ``attempts``.
+    the result's ``attempts`` say so. The augmented observer (``ζ = [x_s; e]``, :mod:`.augmented`) maps with
+    ``S = blkdiag(T diag(σ) T̃ᵀ, diag(σ))``, ``T`` the orthonormal rows spanning ``T̃ diag(σ)⁻¹`` (the read part in
+    the original coordinates); cells map as the general form, G per cell. The scaled solve takes interior points
+    from 1e-7 above the solver's level (its minimiser may sit on the LMI's boundary).
     """
     t0 = time.perf_counter()
     form, objective = kw["form"], kw["objective"]
     augmented = form == "observer" and objective == "hinf" and needs_augmented(system)
-    if system.cells and form == "general" and objective == "hinf":
-        res = synthesize_polytopic(system, **kw)
-        return dataclasses.replace(res, attempts=res.attempts + (
-            "state_scaling='units' not applied: the general form on cells is designed in the given state "
-            "coordinates",))
     verts = system.vertices
     # the coupling K = Σ|Aᵢ| + u vᵀ (u_i: norm of row i of every Bᵢ, v_j: norm of column j of every [Cᵢ; Lᵢ]) moves
     # with the units as A does (K_ij ∝ t_j / t_i) and closes the chains of a double integrator, which |A| alone
