@@ -85,8 +85,10 @@ PARAMS = [pytest.param(name, form, n, which, factor,
                        marks=() if name == "double_integrator" or ((factor, which) == (1e-3, "positions") and form == "general")
                        else pytest.mark.slow)
           for name, form, n in CASES for which in ("all", "positions") for factor in FACTORS]
-# the flexible attitude polytope (augmented observer on cells, ~6 s a design): two of the unit changes, slow
-PARAMS += [pytest.param("flexible_attitude_20pct", "observer", 4, which, factor, marks=pytest.mark.slow)
+# the flexible attitude polytope (augmented observer on cells, ~6 s a design): two of the unit changes, slow;
+# and the closed-loop one in the general form on cells (~14 s a design)
+PARAMS += [pytest.param(name, form, 4, which, factor, marks=pytest.mark.slow)
+           for name, form in (("flexible_attitude_20pct", "observer"), ("flexible_attitude_closed_loop_20pct", "general"))
            for which, factor in (("positions", 1e-6), ("all", 1e6))]
 
 
