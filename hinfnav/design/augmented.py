@@ -94,9 +94,29 @@ def certify_augmented(system, A_F, B_F, C_F, witness: Mapping[str, Any]) -> tupl
             if P.shape != Ab.shape or G.shape != Ab.shape:
                 raise InputError(f"the witness has P of shape {P.shape} and G of shape {G.shape}; the augmented "
                                  f"error system has {Ab.shape[0]} states")
-            N0 = extended_hinf_positive(P, G @ Ab, G @ Bb, Cb, G, 0.0)
-            per.append(schur_gamma(-N0, hinf_gamma_index(Ab.shape[0], Bb.shape[1]))[0])
+            per.append(e1_gamma(P, G, Ab, Bb, Cb))
     return max(per), per
+
+
+def e1_gamma(P, G, Ab, Bb, Cb) -> float:
+    """Smallest γ making (E1) positive definite in float64, as given or in unit-diagonal coordinates (internal).
+
+    The second test is the same inequality as ``D N D``, ``D = diag(d, d, I, I)``, ``d_i`` the power of two
+    nearest ``1/√P_ii`` (exact in floating point: the coordinates in which P has a unit diagonal, as a plant in
+    other state units needs, issue 36), with noise far from unit scale (``‖D⁻¹B̄‖`` outside [1e-2, 1e2]) taken at
+    the nearest power of two. Both are certificates; the smaller is returned.
+    """
+    idx = hinf_gamma_index(Ab.shape[0], Bb.shape[1])
+    g = schur_gamma(-extended_hinf_positive(P, G @ Ab, G @ Bb, Cb, G, 0.0), idx)[0]
+    dP = np.diag(P)
+    if np.all(dP > 0) and np.all(np.isfinite(dP)):
+        d = 2.0 ** np.round(np.log2(1.0 / np.sqrt(dP)))
+        s2 = float(np.linalg.norm(Bb / d[:, None], 2))
+        r2 = 2.0 ** round(np.log2(s2)) if s2 > 0 and np.isfinite(s2) and not 1e-2 <= s2 <= 1e2 else 1.0
+        N2 = extended_hinf_positive(P, G @ Ab, G @ (Bb / r2), Cb, G, 0.0)
+        dd = np.concatenate([d, d, np.ones(N2.shape[0] - 2 * d.size)])
+        g = min(g, schur_gamma(-(dd[:, None] * N2 * dd[None, :]), idx)[0] * r2)
+    return g
 
 
 def augmented_norms(system, A_F, B_F, C_F, witness, alphas):
@@ -131,7 +151,7 @@ def cell_alphas(system, points: int | None = None, n_random: int = 0, seed=0) ->
 
 
 def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alphas=None,
-                              names: Sequence[str] | None = None) -> dict[str, Any]:
+                              names: Sequence[str] | None = None, steps: tuple = DOUBLING) -> dict[str, Any]:
     """Design and certify an observer-form filter on ζ (internal; wrapped by ``synthesize_polytopic``).
 
     With ``system.cells`` each cell has its own slack and Lyapunov matrices
@@ -172,7 +192,7 @@ def design_augmented_observer(system, lyapunov: str, solvers: Sequence[str], alp
     run = Loop()
     for slv in solvers:
         solve_and_certify([(f"augmented observer, {len(cells)} cells", solve)], [slv], certify, rtol=TIGHT,
-                          max_bisection=5, steps=DOUBLING, loop=run)
+                          max_bisection=5, steps=steps, loop=run)
         best = run.best()
         if best is not None and best.check.gamma <= best.level * (1 + TIGHT):
             break  # within 2 % of the solver's own optimum: the next solver would not do much better

@@ -21,13 +21,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.certificates import schur_gamma
 from ..analysis.error_system import worst_case_norm
 from ..core.exceptions import InputError
 from ..lmi.cells_general import solve_cells_general
-from ..lmi.polytopic import extended_hinf_positive, hinf_gamma_index
 from ..lmi.solve import Solution
-from .augmented import cell_alphas, cell_weights
+from .augmented import cell_alphas, cell_weights, e1_gamma
 from .certify_loop import Check, Loop, loop_outcome, solve_and_certify
 
 __all__ = ["certify_cells_general", "design_cells_general"]
@@ -56,8 +54,7 @@ def certify_cells_general(system, A_F, B_F, C_F, witness: Mapping[str, Any]) -> 
             k += 1
             if P.shape != Ab.shape or G.shape != Ab.shape:
                 raise InputError(f"the witness's P {P.shape} or G {G.shape} does not fit the error system {Ab.shape}")
-            N0 = extended_hinf_positive(P, G @ Ab, G @ Bb, Cb, G, 0.0)
-            per.append(schur_gamma(-N0, hinf_gamma_index(Ab.shape[0], Bb.shape[1]))[0])
+            per.append(e1_gamma(P, G, Ab, Bb, Cb))
     return max(per), per
 
 
@@ -79,7 +76,8 @@ def _certify(system, sol, cells, alphas):
             "norms": norms, "radii": radii}
 
 
-def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[str, Any]:
+def design_cells_general(system, lyapunov: str, solvers: Sequence[str], steps: tuple = (1e-3, 1e-2, 5e-2, 0.2, 1.0)
+                         ) -> dict[str, Any]:
     """Design and certify a general-form filter on the cells (internal; wrapped by ``synthesize_polytopic``).
 
     Through the one certify loop (:func:`~hinfnav.design.certify_loop.solve_and_certify`), one solver at a time
@@ -100,7 +98,7 @@ def design_cells_general(system, lyapunov: str, solvers: Sequence[str]) -> dict[
     run = Loop()
     for slv in solvers:  # any certified point is accepted (rtol = inf): no bisection
         solve_and_certify([(f"general, {len(cells)} cells", solve)], [slv], certify, rtol=math.inf,
-                          max_bisection=0, steps=(1e-3, 1e-2, 5e-2, 0.2, 1.0), loop=run)
+                          max_bisection=0, steps=steps, loop=run)
         if run.candidates:
             break
     return loop_outcome(run, alphas=alphas)

@@ -91,12 +91,14 @@ def design_from_system_file(path: str | os.PathLike[str], *, lyapunov: str | Non
         if not isinstance(system, PolytopicSystem):
             system = PolytopicSystem.from_norm_bounded(system)
         lyapunov = lyapunov or ("parameter-dependent" if system.n_vertices > 1 else "common")
-        result = synthesize_polytopic(system, lyapunov=lyapunov, form=form, solver=solver, objective="h2")
+        result = synthesize_polytopic(system, lyapunov=lyapunov, form=form, solver=solver, objective="h2",
+                                      state_scaling="units")
     elif isinstance(system, PolytopicSystem):
-        result = synthesize_polytopic(system, lyapunov=lyapunov or "parameter-dependent", form=form, solver=solver)
+        result = synthesize_polytopic(system, lyapunov=lyapunov or "parameter-dependent", form=form, solver=solver,
+                                      state_scaling="units")
     elif system.H is not None and lyapunov == "parameter-dependent":
         result = synthesize_polytopic(PolytopicSystem.from_norm_bounded(system), lyapunov=lyapunov, form=form,
-                                      solver=solver)
+                                      solver=solver, state_scaling="units")
     else:
         # the state units of a file must not change the design (issue 36): the unit-free scaling
         result = synthesize(system, form=form, options=SolverOptions.only(solver, state_scaling="units"),

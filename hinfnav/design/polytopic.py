@@ -40,11 +40,11 @@ from ..core.exceptions import CertificationError, InfeasibleLMIError, InputError
 from ..core.linalg import spectral_radius
 from ..core.validation import as_choice, as_int_at_least
 from ..lmi.polytopic import extended_h2_matrices, extended_hinf_positive, hinf_gamma_index, polytopic_problem
-from ..lmi.conditioning import pow2
+from ..lmi.conditioning import noise_scale, pow2, round_mantissa, unit_scaling
 from ..lmi.solve import INFEASIBLE, SOLVERS
 from ..systems.polytopic import PolytopicSystem, simplex_grid
 from ..systems.uncertain import UncertainSystem
-from .augmented import augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
+from .augmented import DOUBLING, augmented_norms, certify_augmented, design_augmented_observer, needs_augmented
 from .cells import certify_cells_general, design_cells_general
 from .explain import small_gain_number, unstable_plant_message
 from .certify_loop import Check, solve_and_certify
@@ -118,8 +118,22 @@ def certify_polytopic(system: PolytopicSystem, A_F: ArrayLike, B_F: ArrayLike, C
         s = float(np.linalg.norm(Bbar, 2))
         r = pow2(s) if s > 0 and np.isfinite(s) and not NOISE_WINDOW[0] <= s <= NOISE_WINDOW[1] else 1.0
         N0 = extended_hinf_positive(P, G @ Abar, G @ (Bbar / r), Cbar, G, 0.0)
-        g, _ = schur_gamma(-N0, hinf_gamma_index(Abar.shape[0], Bbar.shape[1]))
-        per.append(g * r)
+        idx = hinf_gamma_index(Abar.shape[0], Bbar.shape[1])
+        g, _ = schur_gamma(-N0, idx)
+        g *= r
+        # states far from unit scale (other state units, issue 36): the same inequality tested as D N D, D =
+        # diag(d, d, I, I), d_i the power of two nearest 1/√P_ii (exact in floating point; the coordinates ξ = D ξ̂ in
+        # which P has a unit diagonal, B̄ → D⁻¹B̄ for the noise scale); either value is a certificate
+        dP = np.diag(P)
+        if np.all(dP > 0) and np.all(np.isfinite(dP)):
+            d = np.array([pow2(1.0 / np.sqrt(x)) for x in dP])
+            if np.any(d != 1.0):
+                s2 = float(np.linalg.norm(Bbar / d[:, None], 2))
+                r2 = pow2(s2) if s2 > 0 and np.isfinite(s2) and not NOISE_WINDOW[0] <= s2 <= NOISE_WINDOW[1] else 1.0
+                N2 = extended_hinf_positive(P, G @ Abar, G @ (Bbar / r2), Cbar, G, 0.0)
+                dd = np.concatenate([d, d, np.ones(N2.shape[0] - 2 * d.size)])
+                g = min(g, schur_gamma(-(dd[:, None] * N2 * dd[None, :]), idx)[0] * r2)
+        per.append(g)
     return max(per), per
 
 
@@ -195,7 +209,8 @@ def _check(system, form):
 
 def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-dependent", form: str = "general",
                          solver: str | None = None, grid_points: int | None = None, seed: int | np.random.Generator = 0,
-                         objective: str = "hinf") -> DesignResult:
+                         objective: str = "hinf", state_scaling: str | None = None,
+                         _steps: tuple | None = None) -> DesignResult:
     """Certified H∞ filter for every system of a polytope (extended LMIs, de Oliveira et al. 2002).
 
     Parameters
@@ -220,6 +235,12 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     objective : {"hinf", "h2"}, optional
         ``"h2"``: minimize the H2 bound ``tr W`` of the extended H2 LMIs (E2)
         instead (same filter parametrization; the result's norms are H2).
+    state_scaling : {None, "units"}, optional
+        ``"units"``: solve in the coordinates ``x = diag(σ) x̃`` of
+        :func:`hinfnav.lmi.conditioning.unit_scaling` (σ moves with the state
+        units, so the solver sees the same data whatever units the file is
+        written in) and map the filter and witness back; the result is
+        certified on the original data (issue 36). ``None``: as given.
 
     Returns
     -------
@@ -247,11 +268,14 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
         alphas = simplex_grid(N, points=41 if N <= 2 else 200, n_random=0 if N <= 2 else 20, seed=seed)
     else:
         alphas = simplex_grid(N, points=as_int_at_least("grid_points", grid_points, 1), n_random=0, seed=seed)
+    if state_scaling is not None and as_choice("state_scaling", state_scaling, ("units",)) == "units":
+        return _in_unit_free_coordinates(system, lyapunov=lyapunov, form=form, solver=solver, grid_points=grid_points,
+                                         seed=seed, objective=objective)
     if form == "observer" and objective == "hinf" and needs_augmented(system):
-        return _augmented_result(system, lyapunov, solvers, alphas, t0)
+        return _augmented_result(system, lyapunov, solvers, alphas, t0, _steps)
     _check(system, form)
     if form == "general" and objective == "hinf" and system.cells:
-        return _cells_result(system, lyapunov, solvers, t0)
+        return _cells_result(system, lyapunov, solvers, t0, _steps)
     verts = _vertex_tuples(system)
     rho = _noise_normalisation(verts) if objective == "hinf" else 1.0
     if rho != 1.0:  # (E1) with B̄/ρ at level γ²/ρ² is a congruence of (E1): same witness, γ × ρ (issue 36)
@@ -271,7 +295,7 @@ def synthesize_polytopic(system: PolytopicSystem, *, lyapunov: str = "parameter-
     # the one certify loop (hinfnav.design.certify_loop): each solver's minimisation, stopping when one certifies
     # within 1e-5 of its own level; then an interior point just above the lowest level (no bisection)
     run = solve_and_certify([("as given", solve)], list(solvers), certify, rtol=1e-5, max_bisection=0,
-                            steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1))
+                            steps=(1e-5, 1e-4, 1e-3, 1e-2, 1e-1) if _steps is None else _steps)
     log, seconds = run.log, run.seconds
     statuses = [f"{slv} {st}" for slv, st in run.statuses]
     top = run.best()
@@ -323,9 +347,10 @@ def _noise_normalisation(verts):
     return float(s)
 
 
-def _augmented_result(system, lyapunov, solvers, alphas, t0):
+def _augmented_result(system, lyapunov, solvers, alphas, t0, steps=None):
     """Observer form when A, C or L vary: the augmented error system [x_s; e] (:mod:`.augmented`; internal)."""
-    out = design_augmented_observer(system, lyapunov, solvers, alphas if not system.cells else None)
+    out = design_augmented_observer(system, lyapunov, solvers, alphas if not system.cells else None,
+                                    steps=steps + DOUBLING if steps is not None else DOUBLING)
     alphas = out["alphas"]
     if not out["ok"]:
         if all(any(s.endswith(st) for st in INFEASIBLE) for s in out["statuses"]):
@@ -351,9 +376,10 @@ def _augmented_result(system, lyapunov, solvers, alphas, t0):
         objective="hinf")
 
 
-def _cells_result(system, lyapunov, solvers, t0):
+def _cells_result(system, lyapunov, solvers, t0, steps=None):
     """General form on a polytope with cells: :mod:`.cells` (internal)."""
-    out = design_cells_general(system, lyapunov, solvers)
+    out = design_cells_general(system, lyapunov, solvers,
+                               *(() if steps is None else (steps + (0.2, 1.0),)))
     if not out["ok"]:
         raise CertificationError("no general-form solution of (E1) on the cells passed certification (solver status: "
                                  + "; ".join(out["statuses"]) + "): " + " | ".join(out["log"]))
@@ -395,7 +421,7 @@ def _rebuild_and_certify(system, sol, form, alphas, objective="hinf"):
     return gamma_c, A_F, B_F, C_F, witness, norms, radii, ok
 
 
-def observer_nominal(system, dt, solvers, t_start):
+def observer_nominal(system, dt, solvers, t_start, state_scaling=None):
     """Nominal observer-form filter of a plant that need not be stable, as a norm-bounded :class:`DesignResult`.
 
     The estimation error ``e⁺ = (A + B_F C) e + B w + B_F D v`` does not
@@ -407,7 +433,8 @@ def observer_nominal(system, dt, solvers, t_start):
     """
     system = UncertainSystem(system.A, system.B, system.C, system.D, system.L, dt=1.0 if dt is True else dt)
     poly = PolytopicSystem((system,), system.dt)
-    res = synthesize_polytopic(poly, lyapunov="common", form="observer", solver=solvers[0] if len(solvers) == 1 else None)
+    res = synthesize_polytopic(poly, lyapunov="common", form="observer", solver=solvers[0] if len(solvers) == 1 else None,
+                               state_scaling=state_scaling)
     return dataclasses.replace(
         res, worst_sample=0, total_time_s=time.perf_counter() - t_start, method="minimize", dt=dt,
         witness={"P": res.witness["P"], "G": res.witness["G"], "lyapunov": "common",
@@ -415,3 +442,92 @@ def observer_nominal(system, dt, solvers, t_start):
         attempts=res.attempts + ("nominal observer form in error coordinates: the plant need not be stable",),
         samples=(None,), system=system, uncertainty="norm-bounded", alphas=None, covers=COVERS_NOMINAL,
     )
+
+
+def _in_unit_free_coordinates(system, **kw):
+    """:func:`synthesize_polytopic` in the unit-free state coordinates, certified on the original data (internal).
+
+    With ``x = T x̃``, ``T = diag(σ)`` from :func:`~hinfnav.lmi.conditioning.unit_scaling` (on ``Σ|Aᵢ|`` and
+    the row norms of the ``Bᵢ`` against the column norms of the ``[Cᵢ; Lᵢ]``), each vertex is ``(T⁻¹AᵢT, T⁻¹Bᵢ, CᵢT, Dᵢ,
+    LᵢT)``, rounded to :data:`~hinfnav.lmi.conditioning.SOLVER_DATA_BITS` bits so that the same plant in other
+    units gives the solver bitwise the same data. The error system's transfer function, hence γ, is unchanged:
+
+    * general form: the filter's input/output map does not depend on the plant's coordinates, so
+      ``(A_F, B_F, C_F)`` is kept; ``ξ = S ξ̃`` with ``S = diag(T, I)``;
+    * observer form (``A_F = A + B_F C``, ``C_F = −L``): ``B_F = T B̃_F``, ``A_F = T Ã_F T⁻¹``; ``e = T ẽ``,
+      ``S = T``.
+
+    (E1)/(E2) map by the congruence ``diag(S⁻ᵀ, S⁻ᵀ, I, I)``: ``P = S⁻ᵀ P̃ S⁻¹``, ``G = S⁻ᵀ G̃ S⁻¹``, ``W``
+    unchanged. The mapped filter and witness are certified again by :func:`certify_polytopic` and the sampled
+    norms on the ORIGINAL vertices; if that fails in float64 (conditioning), the design is redone as given and
+    the result's ``attempts`` say so. The augmented observer (``ζ = [x_s; e]``, :mod:`.augmented`) maps with
+    ``S = blkdiag(T diag(σ) T̃ᵀ, diag(σ))``, ``T`` the orthonormal rows spanning ``T̃ diag(σ)⁻¹`` (the read part in
+    the original coordinates); cells map as the general form, G per cell. The scaled solve takes interior points
+    from 1e-7 above the solver's level (its minimiser may sit on the LMI's boundary).
+    """
+    t0 = time.perf_counter()
+    form, objective = kw["form"], kw["objective"]
+    augmented = form == "observer" and objective == "hinf" and needs_augmented(system)
+    verts = system.vertices
+    # the coupling K = Σ|Aᵢ| + u vᵀ (u_i: norm of row i of every Bᵢ, v_j: norm of column j of every [Cᵢ; Lᵢ]) moves
+    # with the units as A does (K_ij ∝ t_j / t_i) and closes the chains of a double integrator, which |A| alone
+    # leaves open (Osborne's iteration then cannot remove a position/velocity unit ratio)
+    # (u from B/ρ₀, ρ₀ = noise_scale: unit-free and ∝ the noise, so σ does not move with B, D × k either)
+    u = np.linalg.norm(np.hstack([v.B for v in verts]), axis=1) / max(noise_scale(v) for v in verts)
+    w = np.linalg.norm(np.vstack([np.vstack([v.C, v.L]) for v in verts]), axis=0)
+    # (2000 sweeps: the flexible attitude polytope needs ~1000 to converge to 1e-13; the iteration stops when converged)
+    sig = unit_scaling(sum(np.abs(v.A) for v in verts), u[:, None], w[None, :], sweeps=2000)
+    if not (np.all(np.isfinite(sig)) and np.all(sig > 0)):
+        sig = np.ones(verts[0].A.shape[0])
+    scaled = PolytopicSystem(tuple(dataclasses.replace(
+        v, A=round_mantissa(v.A * sig[None, :] / sig[:, None]), B=round_mantissa(v.B / sig[:, None]),
+        C=round_mantissa(v.C * sig[None, :]), L=round_mantissa(v.L * sig[None, :])) for v in verts),
+        system.dt, system.labels, system.cells)
+    try:  # interior points from 1e-7 above the solver's level: the minimiser may sit on the LMI's boundary
+        res = synthesize_polytopic(scaled, **kw, _steps=(1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+                                   if not augmented else (1e-7, 1e-6, 1e-5, 1e-4, 1e-3))
+    except (InfeasibleLMIError, CertificationError) as exc:
+        res, why = None, f"{type(exc).__name__}: {exc}"
+    if res is not None:
+        if augmented:
+            # read part in the original coordinates: the row space of T̃ diag(σ)⁻¹, orthonormal rows (as read_part's)
+            c, Tt = system.center(), np.atleast_2d(np.asarray(res.witness["T"], dtype=float))
+            T = np.linalg.qr((Tt / sig[None, :]).T)[0].T
+            M = T @ (sig[:, None] * Tt.T)
+            B_F = sig[:, None] * res.B_F
+            A_F, C_F = c.A + B_F @ c.C, -c.L.copy()
+            S = None
+        elif form == "observer":
+            v0 = verts[0]
+            B_F = sig[:, None] * res.B_F
+            A_F, C_F = v0.A + B_F @ v0.C, -v0.L.copy()
+            S = sig
+        else:
+            A_F, B_F, C_F = res.A_F, res.B_F, res.C_F
+            S = np.concatenate([sig, np.ones(res.A_F.shape[0])])
+        if S is None:
+            Si = np.linalg.inv(np.block([[M, np.zeros((M.shape[0], sig.size))],
+                                         [np.zeros((sig.size, M.shape[1])), np.diag(sig)]]))
+            witness = dict(res.witness, P=[Si.T @ np.asarray(P) @ Si for P in res.witness["P"]],
+                           G=np.einsum("ji,...jk,kl->...il", Si, np.asarray(res.witness["G"]), Si), T=T, C0=c.C.copy())
+        else:
+            cong = np.outer(1.0 / S, 1.0 / S)
+            witness = dict(res.witness, P=[cong * np.asarray(P) for P in res.witness["P"]], G=cong * res.witness["G"])
+        gamma_c, _ = certify_polytopic(system, A_F, B_F, C_F, witness, form)
+        norms, radii, _ = sampled_norms(system, A_F, B_F, C_F, form, res.alphas, objective,
+                                        witness=witness if augmented else None)
+        if np.isfinite(gamma_c) and np.all(radii < 1.0) and np.max(norms) <= gamma_c * (1 + 1e-9):
+            k = int(np.argmax(norms))
+            return dataclasses.replace(
+                res, A_F=A_F, B_F=B_F, C_F=C_F, gamma=float(gamma_c), verified_norm=float(norms[k]),
+                sample_norms=norms, worst_sample=k, spectral_radius=float(np.max(radii)), witness=witness,
+                system=system, total_time_s=time.perf_counter() - t0,
+                attempts=res.attempts + ("solved in unit-free state coordinates x = diag(σ) x̃ (state_scaling="
+                                         "'units'); filter and witness mapped back and certified on the original "
+                                         "data",))
+        why = (f"the design in unit-free coordinates (γ {res.gamma:.10g}) did not certify on the original data in "
+               f"float64 (γ {gamma_c:.10g}, sampled worst {np.max(norms):.10g})")
+    res = synthesize_polytopic(system, **kw)
+    return dataclasses.replace(res, total_time_s=time.perf_counter() - t0,
+                               attempts=res.attempts + (f"state_scaling='units' not used: {why}; designed in the "
+                                                        "given state coordinates",))

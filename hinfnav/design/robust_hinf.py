@@ -374,7 +374,9 @@ def synthesize(system: UncertainSystem, *, structure: str = "full",
     if system.H is not None and not (np.any(system.H) and np.any(system.E)):
         system = dataclasses.replace(system, H=None, E=None)
     if form == "observer" and system.H is None and not spectral_radius(system.A) < 1.0:
-        return observer_nominal(system, dt_value, solvers, t_start)  # needs detectability only (no plant state)
+        return observer_nominal(system, dt_value, solvers, t_start,  # needs
+                                "units" if isinstance(options.state_scaling, str) and options.state_scaling == "units"
+                                else None)  # detectability only (no plant state)
     sample_set = uncertainty_samples if isinstance(uncertainty_samples, SampleSet) else None
     if uncertainty_samples is None:
         samples = default_uncertainty_samples(system, structure, n_random_samples, seed)

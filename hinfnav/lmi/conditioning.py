@@ -36,6 +36,7 @@ __all__ = [
     "prepare",
     "state_scaling",
     "unit_scaling",
+    "round_mantissa",
     "pow2",
     "NORMALIZE_THRESHOLD",
     "block_scales",
@@ -364,6 +365,14 @@ def normalize(P, threshold=NORMALIZE_THRESHOLD):
 SOLVER_DATA_BITS = 32
 
 
+def round_mantissa(M: ArrayLike | None, bits: int = SOLVER_DATA_BITS) -> NDArray[np.float64] | None:
+    """``M`` rounded to ``bits`` mantissa bits (``None`` stays ``None``): data equal to a few ulps become equal."""
+    if M is None:
+        return None
+    m, e = np.frexp(np.asarray(M, dtype=float))
+    return np.ldexp(np.round(m * 2.0**bits) / 2.0**bits, e)
+
+
 def solver_data(P: Prepared) -> Prepared:
     """The data handed to the solver: ``P`` itself, or with ``noise_ref`` set, ``P`` rounded to 32 mantissa bits.
 
@@ -380,12 +389,7 @@ def solver_data(P: Prepared) -> Prepared:
     if not P.noise_ref > 0:
         return P
 
-    def rnd(M):
-        if M is None:
-            return None
-        m, e = np.frexp(np.asarray(M, dtype=float))
-        return np.ldexp(np.round(m * 2.0**SOLVER_DATA_BITS) / 2.0**SOLVER_DATA_BITS, e)
-
+    rnd = round_mantissa
     return dataclasses.replace(P, A=rnd(P.A), B=rnd(P.B), C=rnd(P.C), D=rnd(P.D), L=rnd(P.L), H=rnd(P.H), E=rnd(P.E))
 
 
