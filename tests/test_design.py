@@ -311,7 +311,7 @@ def test_infeasible_lmi_carries_solver_status():
 
 def test_certification_failure_is_reported(monkeypatch):
     # if no solution survives the checks, CertificationError says why
-    def refuse(P, sol, system, samples, dt):
+    def refuse(P, sol, system, samples, dt, split=False):
         return robust_hinf._Check(False, "forced refusal for the test")
 
     monkeypatch.setattr(robust_hinf, "_rebuild_and_certify", refuse)

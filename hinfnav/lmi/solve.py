@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 
 import cvxpy as cp
 import numpy as np
+import scs
 
 from ..core.exceptions import InputError
 from ..core.validation import as_choice, as_int_at_least, as_positive
@@ -286,8 +287,6 @@ SCS_SIGINT = -5
 @contextlib.contextmanager
 def _scs_interrupts() -> Iterator[None]:
     """While inside, an SCS solve that SCS stopped on Ctrl-C raises KeyboardInterrupt (cvxpy calls ``scs.solve``)."""
-    import scs
-
     original = scs.solve
 
     def solve(*args: Any, **kwargs: Any) -> Any:
