@@ -54,3 +54,28 @@ def test_absurd_readings_refused_and_non_finite_estimates_raise(make):
     est = type(est)(wild, SENSOR, P0=np.eye(2))
     with pytest.raises(FilterDivergedError, match=r"diverged at step \d"):
         est.estimate(np.ones((1, 6, 1)), np.zeros((1, 6, 0)), np.zeros(2))
+
+
+@pytest.mark.parametrize("backend", ["numpy", "auto"])
+def test_nonfinite_flag_policy_carries_the_diverged_runs_on(backend):
+    # the campaign's policy (issue 36 item 5, "raises, or flags per a documented policy"): the same wild plant as
+    # above, two runs; the covariance multiplies by 1e200 a step, so it overflows at step 2 (closed form:
+    # 1e200² > 1.8e308); with nonfinite="flag" the history comes back, finite before, not finite from there on
+    wild = LinearSystem(1e100 * np.eye(2), np.zeros((2, 0)), np.eye(2), 0.1, SYS.state)
+    est = ExtendedKalmanFilter(wild, SENSOR, P0=np.eye(2))
+    est.nonfinite = "flag"
+    hist = est.estimate(np.ones((2, 6, 1)), np.zeros((2, 6, 0)), np.zeros(2), backend=backend)
+    P = hist.P if hist.P.ndim == 4 else hist.P[None]  # (runs, steps, n, n), or one covariance shared by the runs
+    finite = np.isfinite(P).all(axis=(0, 2, 3))
+    assert finite[:2].all() and not finite[-1]
+    with pytest.raises(InputError, match="nonfinite must be one of 'raise', 'flag'"):
+        est.nonfinite = "ignore"
+
+
+def test_campaign_cells_flag_nonfinite_runs():
+    # a campaign cell counts a run that blows up as diverged instead of failing the whole cell
+    from hinfnav.campaign.runner import _estimator
+    from hinfnav.papers.sun2011 import Scenario
+
+    est = _estimator(Scenario(duration_s=20.0, rms_window_s=(0.0, 20.0)), "sun2011", {}, "ekf", {})
+    assert est.nonfinite == "flag"

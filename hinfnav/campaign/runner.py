@@ -98,7 +98,9 @@ def _estimator(scenario, name, settings, est, options):
         if len(_BUILT) >= _MAX_BUILT:
             _BUILT.clear()
         _BUILT[key] = build_estimator(scenario, est, **options)
-    return _BUILT[key]
+    built = _BUILT[key]
+    built.nonfinite = "flag"  # a run that blows up is counted (status "diverged"), not the end of the cell
+    return built
 
 
 def campaign_units(campaign: Campaign, pending: Collection[str] | None = None) -> list[dict[str, Any]]:

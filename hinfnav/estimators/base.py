@@ -75,6 +75,8 @@ __all__ = ["FilterState", "StepOutput", "EstimateHistory", "Estimator", "check_e
 
 #: What an estimator does with a NaN channel of a reading: refuse it, or skip it (see :class:`Estimator`).
 MISSING = ("refuse", "skip")
+#: The values of :attr:`Estimator.nonfinite`.
+NONFINITE_POLICIES = ("raise", "flag")
 
 
 def available_channels(y):
@@ -263,6 +265,12 @@ class Estimator:
     vectorized = True
     #: the noise matrices checked whenever they are set again after construction (name → must be definite)
     checked_covariances = {"Q": False, "R": True, "P0": True}
+    #: The non-finite policy (:meth:`_check_finite`): ``"raise"`` (default) raises :class:`FilterDivergedError` at
+    #: the step where an estimate or covariance stops being finite; ``"flag"`` carries the NaN/inf on in the runs
+    #: it reached, so that a Monte Carlo campaign counts those runs as diverged (``nonfinite_runs``, status
+    #: ``"diverged"``) and keeps the others. Both backends behave the same (the compiled path hands a non-finite
+    #: batch back to the NumPy loop, which applies the policy at its step).
+    nonfinite = "raise"
 
     def __setattr__(self, name: str, value: Any) -> None:
         """Q, R and P0 set after construction are checked as the constructor checks them (issue 36).
@@ -270,6 +278,9 @@ class Estimator:
         A new value must be a finite symmetric matrix of the size the filter was built with, positive
         semidefinite (Q) or definite (R, P0); a per-run or per-step stack (3-D) keeps its shape.
         """
+        if name == "nonfinite" and value not in NONFINITE_POLICIES:
+            raise InputError(f"{type(self).__name__}.nonfinite must be one of {', '.join(map(repr, NONFINITE_POLICIES))}; "
+                             f"got {value!r}")
         old = self.__dict__.get(name) if name in self.checked_covariances else None
         if old is not None and value is not None:
             old_arr = np.asarray(old)
@@ -453,12 +464,15 @@ class Estimator:
         return self._predict(state, u)
 
     def _check_finite(self, out, k):
-        """The non-finite policy: an estimate or covariance with NaN or inf raises :class:`FilterDivergedError`.
+        """The non-finite policy (:attr:`nonfinite`): by default an estimate or covariance with NaN or inf raises
+        :class:`FilterDivergedError`; with ``nonfinite = "flag"`` it is carried on.
 
         Every path does this at the step where it happens (the compiled one by handing a non-finite batch back
         to this loop), so the NumPy and numba backends refuse the same inputs. A skipped reading leaves the
         prior, which is finite; NaN marks nothing else in an estimate.
         """
+        if self.nonfinite == "flag":
+            return
         if not np.isfinite(out.xhat).all() or (out.P is not None and not np.isfinite(out.P).all()):
             what = "estimate" if not np.isfinite(out.xhat).all() else "covariance"
             raise FilterDivergedError(f"filter {self.name!r} diverged at step {k}: its {what} is not finite (NaN or "
