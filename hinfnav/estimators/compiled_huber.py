@@ -26,23 +26,31 @@ _N_BACKTRACK = 11  # BACKTRACK = 0.5 ** arange(11)
 
 
 @njit(cache=True, error_model="numpy")
-def _scaled_solve(A, b, usable):
-    """``A⁻¹ b`` by the Jacobi-scaled Cholesky factor (``_spd_solve``); ``(x, ok)``, x = 0 when not ok."""
+def _jacobi_chol(A):
+    """``(L, s, ok)``: the Cholesky factor L of ``diag(s) A diag(s)``, ``s = 1/√diag(A)`` (Jacobi scaling)."""
     n = A.shape[0]
     s = np.empty(n)
-    x = np.zeros(n)
-    if not usable:
-        return x, False
     for i in range(n):
         d = A[i, i]
         if not (np.isfinite(d) and d > 0.0):
-            return x, False
+            return A, s, False
         s[i] = 1.0 / np.sqrt(d)
     As = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             As[i, j] = A[i, j] * s[i] * s[j]
     L, ok = chol(As)
+    return L, s, ok
+
+
+@njit(cache=True, error_model="numpy")
+def _scaled_solve(A, b, usable):
+    """``A⁻¹ b`` by the Jacobi-scaled Cholesky factor (``_spd_solve``); ``(x, ok)``, x = 0 when not ok."""
+    n = A.shape[0]
+    x = np.zeros(n)
+    if not usable:
+        return x, False
+    L, s, ok = _jacobi_chol(A)
     if not ok:
         return x, False
     rhs = np.empty((n, 1))
@@ -204,17 +212,7 @@ def _huber_general(P, A, e, dx, gamma, tol, max_iter):
 def _covariance(A):
     """``(A⁻¹, ok)`` by the Jacobi-scaled Cholesky factor, symmetrised (huber_regression.covariance)."""
     n = A.shape[0]
-    s = np.empty(n)
-    for i in range(n):
-        d = A[i, i]
-        if not (np.isfinite(d) and d > 0.0):
-            return A, False
-        s[i] = 1.0 / np.sqrt(d)
-    As = np.empty((n, n))
-    for i in range(n):
-        for j in range(n):
-            As[i, j] = A[i, j] * s[i] * s[j]
-    L, ok = chol(As)
+    L, s, ok = _jacobi_chol(A)
     if not ok:
         return A, False
     Li = tri_inv(L)
